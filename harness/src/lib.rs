@@ -1,0 +1,8 @@
+//! # steradian-harness
+//!
+//! Wires the kernels of `steradian-core` and `steradian-simd` to backends (CPU scalar, CPU
+//! SIMD, wgpu), holds the exact f64 references, the table generators and the report, and
+//! provides the `steradian` command-line tool.
+
+pub mod backend;
+pub mod kernels;
