@@ -1,0 +1,38 @@
+// steradian: inverse equal-area hemisphere map, disk point -> unit direction (mirrors
+// `hemisphere::unmap`). Input columns [u, v], output columns [x, y, z]; column c of a batch
+// of n rows at c*n. Specified for finite inputs with |p| < 1.8e19 (|p|^2 must not
+// overflow); see `steradian_core::wgsl`.
+
+struct Params {
+    n: u32,
+    row_stride: u32,
+    _pad0: u32,
+    _pad1: u32,
+}
+
+@group(0) @binding(0) var<storage, read> input: array<f32>;
+@group(0) @binding(1) var<storage, read_write> output: array<f32>;
+@group(0) @binding(2) var<uniform> params: Params;
+
+@compute @workgroup_size(64)
+fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
+    let i = gid.x + gid.y * params.row_stride;
+    let n = params.n;
+    if (i >= n) {
+        return;
+    }
+    var px = input[i];
+    var py = input[n + i];
+    var r2 = px * px + py * py;
+    // Points outside the disk are clamped radially onto the unit circle (the horizon).
+    if (r2 > 1.0) {
+        let k = 1.0 / sqrt(r2);
+        px = px * k;
+        py = py * k;
+        r2 = 1.0;
+    }
+    let s = sqrt(2.0 - r2);
+    output[i] = px * s;
+    output[n + i] = py * s;
+    output[2u * n + i] = 1.0 - r2;
+}
