@@ -12,7 +12,7 @@
 //! | 56 | 32 | domain lower bounds `[f64; 4]` |
 //! | 88 | 32 | domain upper bounds `[f64; 4]` |
 //! | 120 | 8 | value count `u64` (= product of dims × channels) |
-//! | 128 | 8 | FNV-1a 64 checksum of the payload bytes |
+//! | 128 | 8 | FNV-1a 64 checksum of bytes `0..128` followed by the payload |
 //! | 136 | 4·count | values `f32` |
 //!
 //! The built-in tables are decoded at compile time by a `const fn` (a corrupt committed table
@@ -84,13 +84,22 @@ pub struct Header {
     pub hi: [f64; 4],
     /// Number of `f32` values in the payload.
     pub count: u64,
-    /// FNV-1a 64 checksum of the payload bytes.
+    /// Checksum of the header prefix and payload (see [`checksum`]).
     pub checksum: u64,
 }
 
-/// FNV-1a 64-bit hash (the table checksum).
+/// FNV-1a 64-bit hash.
 pub const fn fnv1a64(bytes: &[u8]) -> u64 {
-    let mut h: u64 = 0xcbf2_9ce4_8422_2325;
+    fnv1a64_continue(0xcbf2_9ce4_8422_2325, bytes)
+}
+
+/// The table checksum: FNV-1a 64 over the header up to the checksum field, then the payload,
+/// so any single changed byte anywhere in a table is detected.
+pub const fn checksum(header_prefix: &[u8], payload: &[u8]) -> u64 {
+    fnv1a64_continue(fnv1a64(header_prefix), payload)
+}
+
+const fn fnv1a64_continue(mut h: u64, bytes: &[u8]) -> u64 {
     let mut i = 0;
     while i < bytes.len() {
         h ^= bytes[i] as u64;
@@ -177,6 +186,9 @@ impl Header {
             };
             i += 1;
         }
+        if rd_u32(bytes, 20) != 0 {
+            return Err(TableError::BadShape);
+        }
         if rd_u64(bytes, 120) != count {
             return Err(TableError::BadShape);
         }
@@ -187,9 +199,10 @@ impl Header {
         if bytes.len() != HEADER_LEN + payload_len {
             return Err(TableError::Truncated);
         }
-        let checksum = rd_u64(bytes, 128);
-        let (_, payload) = bytes.split_at(HEADER_LEN);
-        if fnv1a64(payload) != checksum {
+        let stored = rd_u64(bytes, 128);
+        let (head, payload) = bytes.split_at(HEADER_LEN);
+        let (prefix, _) = head.split_at(128);
+        if checksum(prefix, payload) != stored {
             return Err(TableError::BadChecksum);
         }
         Ok(Header {
@@ -200,7 +213,7 @@ impl Header {
             lo,
             hi,
             count,
-            checksum,
+            checksum: stored,
         })
     }
 
@@ -343,7 +356,7 @@ pub fn encode_into(spec: &Spec<'_>, values: &[f32], out: &mut [u8]) -> Result<()
         head[88 + 8 * i..96 + 8 * i].copy_from_slice(&spec.hi[i].to_le_bytes());
     }
     head[120..128].copy_from_slice(&count.to_le_bytes());
-    let sum = fnv1a64(payload);
+    let sum = checksum(&head[..128], payload);
     head[128..136].copy_from_slice(&sum.to_le_bytes());
     Header::parse(out).map(|_| ())
 }
@@ -393,9 +406,12 @@ mod tests {
             TableError::Truncated
         );
         assert_eq!(TableView::parse(&good[..10]).unwrap_err(), TableError::Truncated);
-        let mut b = good;
-        b[40] = 4; // dims[0] = 4 but only 3 values
-        assert_eq!(TableView::parse(&b).unwrap_err(), TableError::BadShape);
+        // every single-byte change anywhere is rejected
+        for at in 0..good.len() {
+            let mut b = good;
+            b[at] ^= 0x10;
+            assert!(TableView::parse(&b).is_err(), "flip at {at} accepted");
+        }
         assert_eq!(
             TableView::parse_expecting(&good, "other", 3).unwrap_err(),
             TableError::WrongName
