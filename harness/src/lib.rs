@@ -4,5 +4,12 @@
 //! SIMD, wgpu), holds the exact f64 references, the table generators and the report, and
 //! provides the `steradian` command-line tool.
 
+pub mod accuracy;
 pub mod backend;
+pub mod eval;
+pub mod generate;
 pub mod kernels;
+pub mod reference;
+pub mod report;
+pub mod rng;
+pub mod workload;

@@ -1,1 +1,137 @@
-fn main() {}
+//! The `steradian` command-line tool: `report`, `eval`, `tables`.
+
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+use clap::{Parser, Subcommand};
+use steradian_harness::{eval, generate, report};
+
+#[derive(Parser)]
+#[command(name = "steradian", version, about = "Fast, accurate spherical lighting integrals: report, eval, tables")]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Run every kernel on every available backend; write report.json, index.html and a summary.
+    Report {
+        /// Output directory.
+        #[arg(long, default_value = "report")]
+        out: PathBuf,
+        /// Inputs per kernel for the throughput runs.
+        #[arg(long, default_value_t = 1 << 20)]
+        n: usize,
+        /// Timed repeats per kernel and backend (the median is reported).
+        #[arg(long, default_value_t = 7)]
+        repeats: usize,
+        /// Rows compared against the f64 reference (hard cases first).
+        #[arg(long, default_value_t = 1 << 16)]
+        error_rows: usize,
+        /// Skip the wgpu backend.
+        #[arg(long)]
+        no_gpu: bool,
+    },
+    /// Evaluate a kernel on JSON Lines from stdin, one JSON line out per line in.
+    #[command(after_help = eval_help())]
+    Eval {
+        /// Kernel name (see below).
+        kernel: String,
+    },
+    /// Regenerate the precomputed tables under core/src/tables.
+    Tables {
+        /// Do not write: fail if the committed tables differ from a fresh generation.
+        #[arg(long)]
+        check: bool,
+        /// Directory of the tables (default: this source tree's core/src/tables).
+        #[arg(long)]
+        dir: Option<PathBuf>,
+    },
+}
+
+fn eval_help() -> String {
+    let mut s = String::from("Kernels:\n");
+    for (k, contract) in eval::KERNELS {
+        s += &format!("  {k:<17} {contract}\n");
+    }
+    s + "A bad line gets {\"error\": \"...\"} and the run goes on; the exit status is 1 if any line erred."
+}
+
+fn main() -> ExitCode {
+    match Cli::parse().command {
+        Command::Report {
+            out,
+            n,
+            repeats,
+            error_rows,
+            no_gpu,
+        } => {
+            let opts = report::Options {
+                out,
+                n,
+                repeats,
+                error_rows,
+                gpu: !no_gpu,
+            };
+            match report::run(&opts) {
+                Ok(r) => {
+                    print!("{}", report::summary(&r));
+                    println!(
+                        "wrote {} and {}",
+                        opts.out.join("index.html").display(),
+                        opts.out.join("report.json").display()
+                    );
+                    ExitCode::SUCCESS
+                }
+                Err(e) => {
+                    eprintln!("steradian report: {e}");
+                    ExitCode::FAILURE
+                }
+            }
+        }
+        Command::Eval { kernel } => {
+            if !eval::KERNELS.iter().any(|(k, _)| *k == kernel) {
+                eprintln!("steradian eval: unknown kernel {kernel:?}\n{}", eval_help());
+                return ExitCode::from(2);
+            }
+            let stdin = std::io::stdin().lock();
+            let stdout = std::io::stdout().lock();
+            match eval::run(&kernel, stdin, stdout) {
+                Ok(0) => ExitCode::SUCCESS,
+                Ok(_) => ExitCode::FAILURE,
+                Err(e) => {
+                    eprintln!("steradian eval: {e}");
+                    ExitCode::FAILURE
+                }
+            }
+        }
+        Command::Tables { check, dir } => {
+            let dir = dir.unwrap_or_else(generate::default_dir);
+            match generate::run(&dir, check) {
+                Ok(outcomes) => {
+                    let mut ok = true;
+                    for o in outcomes {
+                        let what = match (check, o.matches) {
+                            (false, _) => "written",
+                            (true, true) => "matches a fresh generation",
+                            (true, false) => "DIFFERS from a fresh generation",
+                        };
+                        ok &= o.matches;
+                        println!("{:<20} {:>8} bytes  {what}", o.file, o.bytes);
+                    }
+                    if ok {
+                        ExitCode::SUCCESS
+                    } else {
+                        eprintln!("run `steradian tables` to regenerate, then commit the tables");
+                        ExitCode::FAILURE
+                    }
+                }
+                Err(e) => {
+                    eprintln!("steradian tables: {}: {e}", dir.display());
+                    ExitCode::FAILURE
+                }
+            }
+        }
+    }
+}

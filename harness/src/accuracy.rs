@@ -1,0 +1,144 @@
+//! Per-kernel error metrics against the f64 references, and their summary statistics.
+
+use serde::Serialize;
+
+use crate::kernels::{Columns, Kernel};
+use crate::reference;
+
+/// Name of the error metric of a kernel (as in `report.json`).
+pub fn metric(kernel: Kernel) -> &'static str {
+    match kernel {
+        Kernel::HemisphereMap | Kernel::HemisphereUnmap => "abs",
+        Kernel::LobeEval => "rel/(1+|ln(c/s)|)",
+        Kernel::LobeIntegral => "rel",
+        Kernel::CapExponent => "excess-L2-rel",
+    }
+}
+
+/// The documented bound of a kernel in its metric.
+pub fn bound(kernel: Kernel) -> f64 {
+    use steradian_core::{cap, hemisphere, lobe};
+    match kernel {
+        Kernel::HemisphereMap => hemisphere::MAP_ABS_ERROR as f64,
+        Kernel::HemisphereUnmap => hemisphere::UNMAP_ABS_ERROR as f64,
+        Kernel::LobeEval => lobe::EVAL_REL_ERROR as f64,
+        Kernel::LobeIntegral => lobe::INTEGRAL_REL_ERROR as f64,
+        Kernel::CapExponent => cap::EXCESS_L2_REL,
+    }
+}
+
+/// Reference data for the first `rows` rows of a batch (computed once, compared against
+/// every backend).
+pub struct Reference {
+    kernel: Kernel,
+    /// Per row: the exact outputs (for the cap exponent: `[e*, J(e*)]`).
+    values: Vec<Vec<f64>>,
+}
+
+/// Computes the reference for the first `rows` rows of `input`.
+pub fn reference(kernel: Kernel, input: &Columns, rows: usize) -> Reference {
+    let rows = rows.min(input.n);
+    let values = (0..rows)
+        .map(|i| {
+            let r = input.row(i);
+            match kernel {
+                Kernel::HemisphereMap => reference::hemisphere_map([r[0], r[1], r[2]]).to_vec(),
+                Kernel::HemisphereUnmap => reference::hemisphere_unmap([r[0], r[1]]).to_vec(),
+                Kernel::LobeEval => vec![reference::lobe_eval(
+                    [r[0], r[1], r[2]],
+                    r[3],
+                    r[4],
+                    [r[5], r[6], r[7]],
+                )],
+                Kernel::LobeIntegral => vec![reference::lobe_integral(r[0], r[1])],
+                Kernel::CapExponent => {
+                    let a = r[0] as f64;
+                    let e = reference::cap::optimal_exponent(a);
+                    vec![e, reference::cap::objective(e, a)]
+                }
+            }
+        })
+        .collect();
+    Reference { kernel, values }
+}
+
+/// The error of row `i` of `out` in the kernel's metric (`+∞` for a non-finite output where
+/// the reference is finite).
+pub fn row_error(r: &Reference, input: &Columns, out: &Columns, i: usize) -> f64 {
+    let got: Vec<f64> = out.row(i).into_iter().map(f64::from).collect();
+    let want = &r.values[i];
+    let err = match r.kernel {
+        Kernel::HemisphereMap | Kernel::HemisphereUnmap => got
+            .iter()
+            .zip(want)
+            .map(|(g, w)| (g - w).abs())
+            .fold(0.0, f64::max),
+        Kernel::LobeEval => {
+            let s = input.row(i)[3] as f64;
+            let (g, w) = (got[0], want[0]);
+            if w.abs() < 1e-30 * s.abs() {
+                (g - w).abs() / s.abs()
+            } else {
+                (g - w).abs() / (w.abs() * (1.0 + (w / s).ln().abs()))
+            }
+        }
+        Kernel::LobeIntegral => {
+            let (g, w) = (got[0], want[0]);
+            if w == 0.0 { g.abs() } else { ((g - w) / w).abs() }
+        }
+        Kernel::CapExponent => {
+            let a = input.row(i)[0] as f64;
+            let best = want[1];
+            let j = reference::cap::objective(got[0], a);
+            if best > 0.0 {
+                (j / best - 1.0).max(0.0)
+            } else {
+                j / reference::cap_solid_angle(a)
+            }
+        }
+    };
+    if err.is_nan() { f64::INFINITY } else { err }
+}
+
+/// Summary of a kernel's errors over a batch.
+#[derive(Clone, Debug, Serialize)]
+pub struct ErrorStats {
+    /// Metric name ([`metric`]).
+    pub metric: &'static str,
+    /// Largest error.
+    pub max: f64,
+    /// Mean error.
+    pub mean: f64,
+    /// 99th percentile.
+    pub p99: f64,
+    /// Rows compared.
+    pub n: usize,
+    /// Row index of the largest error.
+    pub argmax: usize,
+}
+
+/// Errors of `out` against `r` over its rows.
+pub fn stats(r: &Reference, input: &Columns, out: &Columns) -> ErrorStats {
+    let mut errs: Vec<f64> = (0..r.values.len())
+        .map(|i| row_error(r, input, out, i))
+        .collect();
+    let (argmax, max) = errs
+        .iter()
+        .copied()
+        .enumerate()
+        .fold((0, 0.0), |(bi, b), (i, e)| if e > b { (i, e) } else { (bi, b) });
+    let mean = errs.iter().sum::<f64>() / errs.len().max(1) as f64;
+    errs.sort_by(f64::total_cmp);
+    let p99 = errs
+        .get(((errs.len() as f64) * 0.99) as usize)
+        .copied()
+        .unwrap_or(0.0);
+    ErrorStats {
+        metric: metric(r.kernel),
+        max,
+        mean,
+        p99,
+        n: errs.len(),
+        argmax,
+    }
+}

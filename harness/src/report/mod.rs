@@ -1,0 +1,290 @@
+//! `steradian report`: every kernel on every available backend, throughput and error
+//! against the f64 references on the default workload, written as `report.json`,
+//! `index.html` (tables and SVG speed-against-error plots) and a summary on stdout.
+
+mod svg;
+
+use std::path::PathBuf;
+use std::time::{Duration, Instant};
+
+use indicatif::{ProgressBar, ProgressStyle};
+use serde::Serialize;
+
+use crate::accuracy::{self, ErrorStats};
+use crate::backend::{self, Backend};
+use crate::kernels::{Columns, Kernel};
+use crate::workload;
+
+/// Seed of the default workload.
+pub const SEED: u64 = 0x57e4_ad1a;
+
+/// What to run.
+#[derive(Clone, Debug)]
+pub struct Options {
+    /// Output directory.
+    pub out: PathBuf,
+    /// Inputs per kernel for throughput.
+    pub n: usize,
+    /// Timed repeats per kernel × backend (the median is reported).
+    pub repeats: usize,
+    /// Rows compared against the f64 reference (hard cases first).
+    pub error_rows: usize,
+    /// Try the wgpu backend.
+    pub gpu: bool,
+}
+
+impl Default for Options {
+    fn default() -> Self {
+        Options {
+            out: PathBuf::from("report"),
+            n: 1 << 20,
+            repeats: 7,
+            error_rows: 1 << 16,
+            gpu: true,
+        }
+    }
+}
+
+/// The machine the report ran on.
+#[derive(Clone, Debug, Serialize)]
+pub struct Machine {
+    /// CPU model name.
+    pub cpu: String,
+    /// Logical cores.
+    pub cores: usize,
+    /// Instruction set the SIMD batches were built for.
+    pub simd: String,
+    /// GPU adapter that ran the `wgpu` rows, or null.
+    pub gpu_adapter: Option<String>,
+    /// Why there is no GPU row, when there is none.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub gpu_unavailable: Option<String>,
+}
+
+/// One kernel × backend measurement.
+#[derive(Clone, Debug, Serialize)]
+pub struct Row {
+    /// Kernel name.
+    pub kernel: &'static str,
+    /// Backend name.
+    pub backend: &'static str,
+    /// Median evaluations per second.
+    pub evals_per_s: f64,
+    /// Inputs per timed run.
+    pub n: usize,
+    /// Error against the f64 reference.
+    pub error: ErrorStats,
+    /// The kernel's documented bound in the same metric.
+    pub bound: f64,
+    /// Whether `error.max ≤ bound`.
+    pub within_bound: bool,
+}
+
+/// The whole report (`report.json`).
+#[derive(Clone, Debug, Serialize)]
+pub struct Report {
+    /// Where it ran.
+    pub machine: Machine,
+    /// Every measurement.
+    pub results: Vec<Row>,
+}
+
+impl Report {
+    /// The row of `kernel` on `backend`.
+    pub fn get(&self, kernel: &str, backend: &str) -> Option<&Row> {
+        self.results
+            .iter()
+            .find(|r| r.kernel == kernel && r.backend == backend)
+    }
+}
+
+fn cpu_name() -> String {
+    std::fs::read_to_string("/proc/cpuinfo")
+        .ok()
+        .and_then(|s| {
+            s.lines()
+                .find(|l| l.starts_with("model name"))
+                .and_then(|l| l.split(':').nth(1))
+                .map(|s| s.trim().to_string())
+        })
+        .unwrap_or_else(|| std::env::consts::ARCH.to_string())
+}
+
+fn time_median(
+    b: &mut dyn Backend,
+    k: Kernel,
+    input: &Columns,
+    out: &mut Columns,
+    repeats: usize,
+) -> Result<Duration, backend::BackendError> {
+    b.run(k, input, out)?; // warm-up (and pipeline creation on the GPU)
+    let mut times = Vec::with_capacity(repeats);
+    for _ in 0..repeats.max(1) {
+        let t = Instant::now();
+        b.run(k, input, out)?;
+        times.push(t.elapsed());
+    }
+    times.sort();
+    Ok(times[times.len() / 2])
+}
+
+/// Runs the report and writes `report.json` and `index.html` into `opts.out`.
+pub fn run(opts: &Options) -> Result<Report, Box<dyn std::error::Error>> {
+    let mut backends = backend::cpu_backends();
+    let mut machine = Machine {
+        cpu: cpu_name(),
+        cores: std::thread::available_parallelism().map_or(1, |n| n.get()),
+        simd: steradian_simd::isa().to_string(),
+        gpu_adapter: None,
+        gpu_unavailable: None,
+    };
+    if opts.gpu {
+        match backend::gpu::try_gpu() {
+            Ok(g) => {
+                machine.gpu_adapter = Some(g.adapter_info());
+                backends.push(Box::new(g));
+            }
+            Err(why) => machine.gpu_unavailable = Some(why),
+        }
+    }
+    let steps = (Kernel::ALL.len() * (backends.len() + 1)) as u64;
+    let bar = ProgressBar::new(steps).with_style(
+        ProgressStyle::with_template("{spinner} [{elapsed_precise}] {bar:30} {pos}/{len} {msg}")
+            .unwrap_or_else(|_| ProgressStyle::default_bar()),
+    );
+    let mut results = Vec::new();
+    for k in Kernel::ALL {
+        bar.set_message(format!("{k}: inputs and f64 reference"));
+        let input = workload::generate(k, opts.n, SEED);
+        let reference = accuracy::reference(k, &input, opts.error_rows);
+        bar.inc(1);
+        for b in backends.iter_mut() {
+            bar.set_message(format!("{k} on {}", b.name()));
+            let mut out = Columns::zeros(k.output_arity(), opts.n);
+            match time_median(b.as_mut(), k, &input, &mut out, opts.repeats) {
+                Ok(t) => {
+                    let error = accuracy::stats(&reference, &input, &out);
+                    let bound = accuracy::bound(k);
+                    results.push(Row {
+                        kernel: k.name(),
+                        backend: b.name(),
+                        evals_per_s: opts.n as f64 / t.as_secs_f64().max(1e-12),
+                        n: opts.n,
+                        within_bound: error.max <= bound,
+                        error,
+                        bound,
+                    });
+                }
+                Err(e) => bar.println(format!("{k} on {}: {e}", b.name())),
+            }
+            bar.inc(1);
+        }
+    }
+    bar.finish_and_clear();
+    let report = Report { machine, results };
+    std::fs::create_dir_all(&opts.out)?;
+    std::fs::write(
+        opts.out.join("report.json"),
+        serde_json::to_string_pretty(&report)?,
+    )?;
+    std::fs::write(opts.out.join("index.html"), html(&report))?;
+    Ok(report)
+}
+
+fn ratio(r: &Report, row: &Row) -> Option<f64> {
+    r.get(row.kernel, "cpu-scalar")
+        .map(|base| row.evals_per_s / base.evals_per_s)
+}
+
+/// The summary table printed after a run.
+pub fn summary(r: &Report) -> String {
+    let mut s = format!(
+        "steradian report — cpu: {} ({} cores), simd: {}, gpu: {}\n",
+        r.machine.cpu,
+        r.machine.cores,
+        r.machine.simd,
+        r.machine
+            .gpu_adapter
+            .clone()
+            .or_else(|| r.machine.gpu_unavailable.clone().map(|w| format!("none ({w})")))
+            .unwrap_or_else(|| "not tried".into())
+    );
+    s += &format!(
+        "{:<17} {:<16} {:>11} {:>9} {:<19} {:>10} {:>10} {:>10} {:>9}\n",
+        "kernel", "backend", "Mevals/s", "×scalar", "error metric", "max", "p99", "mean", "bound"
+    );
+    for row in &r.results {
+        s += &format!(
+            "{:<17} {:<16} {:>11.1} {:>9} {:<19} {:>10.2e} {:>10.2e} {:>10.2e} {:>9}\n",
+            row.kernel,
+            row.backend,
+            row.evals_per_s / 1e6,
+            ratio(r, row).map_or("-".into(), |x| format!("{x:.2}")),
+            row.error.metric,
+            row.error.max,
+            row.error.p99,
+            row.error.mean,
+            if row.within_bound { "ok" } else { "EXCEEDED" }
+        );
+    }
+    s
+}
+
+fn esc(s: &str) -> String {
+    s.replace('&', "&amp;").replace('<', "&lt;").replace('>', "&gt;")
+}
+
+fn html(r: &Report) -> String {
+    let mut rows = String::new();
+    for row in &r.results {
+        rows += &format!(
+            "<tr><td>{}</td><td>{}</td><td>{:.1}</td><td>{}</td><td>{}</td><td>{:.2e}</td><td>{:.2e}</td><td>{:.2e}</td><td>{:.1e}</td><td class=\"{}\">{}</td></tr>\n",
+            row.kernel,
+            row.backend,
+            row.evals_per_s / 1e6,
+            ratio(r, row).map_or("-".into(), |x| format!("{x:.2}")),
+            esc(row.error.metric),
+            row.error.max,
+            row.error.p99,
+            row.error.mean,
+            row.bound,
+            if row.within_bound { "ok" } else { "bad" },
+            if row.within_bound { "ok" } else { "exceeded" }
+        );
+    }
+    let m = &r.machine;
+    format!(
+        r#"<!doctype html>
+<html lang="en"><head><meta charset="utf-8"><title>steradian report</title>
+<style>
+body {{ font-family: system-ui, sans-serif; margin: 2em; color: #222; }}
+table {{ border-collapse: collapse; }} td, th {{ padding: 0.25em 0.7em; border-bottom: 1px solid #ddd; text-align: right; }}
+td:first-child, td:nth-child(2), td:nth-child(5), th {{ text-align: left; }}
+.ok {{ color: #176117; }} .bad {{ color: #b00; font-weight: bold; }}
+</style></head><body>
+<h1>steradian report</h1>
+<p>CPU: {cpu} ({cores} cores) · SIMD build: {simd} · GPU adapter: {gpu}</p>
+<p>Throughput is the median of timed runs over the default workload (hard cases first, then
+pseudo-random inputs over each kernel's domain). <code>cpu-scalar</code> calls the scalar kernel one input at
+a time behind <code>black_box</code>; <code>cpu-scalar-loop</code> is a plain loop the compiler may vectorise;
+<code>cpu-simd</code> is the explicit 8-lane batch; <code>wgpu</code> includes upload and read-back. ×scalar is the
+ratio to <code>cpu-scalar</code> in the same run. Errors are against f64 references; the bound is the one
+documented on the kernel.</p>
+<h2>Speed against error</h2>
+{svg}
+<h2>All measurements</h2>
+<table><tr><th>kernel</th><th>backend</th><th>Mevals/s</th><th>×scalar</th><th>metric</th><th>max</th><th>p99</th><th>mean</th><th>bound</th><th></th></tr>
+{rows}</table>
+</body></html>
+"#,
+        cpu = esc(&m.cpu),
+        cores = m.cores,
+        simd = esc(&m.simd),
+        gpu = esc(&m
+            .gpu_adapter
+            .clone()
+            .or_else(|| m.gpu_unavailable.clone().map(|w| format!("none ({w})")))
+            .unwrap_or_else(|| "not tried".into())),
+        svg = svg::speed_vs_error(r),
+    )
+}
