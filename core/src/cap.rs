@@ -43,10 +43,8 @@ pub const TABLE_LEN: usize = 512;
 pub const TABLE_NAME: &str = "cap-exponent";
 /// The committed table bytes (header + `h(α) = e*(α)·α²` at `α_i = (π/2)(1 − (1 − i/(N−1))²)`).
 pub static TABLE_BYTES: &[u8] = include_bytes!("tables/cap_exponent.bin");
-const DECODED: (Header, [f32; TABLE_LEN]) = decode_const(
-    include_bytes!("tables/cap_exponent.bin"),
-    TABLE_NAME,
-);
+const DECODED: (Header, [f32; TABLE_LEN]) =
+    decode_const(include_bytes!("tables/cap_exponent.bin"), TABLE_NAME);
 /// The decoded built-in table.
 pub static TABLE: [f32; TABLE_LEN] = DECODED.1;
 
@@ -72,6 +70,14 @@ pub fn exponent_l2(half_angle: f32) -> f32 {
 /// [`exponent_l2`] with a caller-supplied table of `h(α) = e*·α²` samples at
 /// `α_i = (π/2)(1 − (1 − i/(N−1))²)` (for instance one loaded with
 /// [`crate::table::TableView`]). A table with fewer than two samples gives NaN.
+///
+/// With `u = π/2 − α` (computed with a two-part π/2, so it keeps its relative precision
+/// next to the hemisphere) and `r = (N − 1)·sqrt(2u/π)`, the sample interval is
+/// `k = max(⌈r⌉, 1)` counted from the end, and the interpolation is linear in `α` between
+/// its knots: the fraction `(u_i − u)/(u_i − u_{i+1})` simplifies to
+/// `(k − r)(k + r)/(2k − 1)`. Linear in `α` (not in the grid coordinate) matters in the
+/// last intervals, where `e* ∝ u(1 − ln u)`. Every step is monotone, so the lookup is
+/// non-increasing in `α` for every `f32` input (checked exhaustively in the harness).
 #[inline]
 pub fn lookup(table: &[f32], half_angle: f32) -> f32 {
     let n = table.len();
@@ -81,14 +87,17 @@ pub fn lookup(table: &[f32], half_angle: f32) -> f32 {
     let last = (n - 1) as f32;
     // `clamp` keeps NaN; the final division then returns it.
     let a = half_angle.clamp(MIN_HALF_ANGLE, FRAC_PI_2);
-    // Grid coordinate x = 1 − sqrt(1 − α/(π/2)) in [0, 1], scaled to [0, N − 1].
-    let w = math::sqrtf((1.0 - a * (2.0 / core::f32::consts::PI)).max(0.0));
-    let x = ((1.0 - w) * last).min(last);
-    let i = (x as usize).min(n - 2);
-    let f = x - i as f32;
+    let u = ((FRAC_PI_2 - a) + FRAC_PI_2_LO).max(0.0);
+    let r = (math::sqrtf(u * (2.0 / core::f32::consts::PI)) * last).min(last);
+    let k = math::ceilf(r).max(1.0);
+    let i = (last - k) as usize;
+    let f = ((k - r) * (k + r) / (2.0 * k - 1.0)).min(1.0);
     let (h0, h1) = (table[i], table[i + 1]);
     (h0 + f * (h1 - h0)) / (a * a)
 }
+
+/// `π/2 − FRAC_PI_2` (the f32 constant rounds π/2 up by this much).
+const FRAC_PI_2_LO: f32 = -4.371_139e-8;
 
 /// `1 − cos α` without cancellation: `2·sin²(α/2)`.
 #[inline]
@@ -173,8 +182,10 @@ impl SphericalCap {
         let m = v.x.abs().max(v.y.abs()).max(v.z.abs());
         let axis = normalize_or_zero(v);
         // d = m·|v/m| without overflow; sin α = r/d computed as (r/m)/|v/m|.
+        // v/m has length in [1, √3]; dividing (not multiplying by 1/m) stays exact for
+        // subnormal m.
         let unit_len = if m > 0.0 {
-            let s = v * (1.0 / m);
+            let s = v / m;
             math::sqrtf(s.dot(s))
         } else {
             0.0
@@ -284,7 +295,10 @@ mod tests {
         assert!(SphericalCap::from_sphere(Vec3::ZERO, Vec3::Z, 0.0).is_err());
         assert!(SphericalCap::from_sphere(Vec3::ZERO, Vec3::Z * 2.0, f32::NAN).is_err());
         assert!(SphericalCap::from_sphere(Vec3::NAN, Vec3::Z * 2.0, 1.0).is_err());
-        assert!(SphericalCap::from_sphere(Vec3::new(-3e38, 0.0, 0.0), Vec3::new(3e38, 0.0, 0.0), 1.0).is_err());
+        assert!(
+            SphericalCap::from_sphere(Vec3::new(-3e38, 0.0, 0.0), Vec3::new(3e38, 0.0, 0.0), 1.0)
+                .is_err()
+        );
         assert!(SphericalCap::new(Vec3::Z, 0.0).is_err());
         assert!(SphericalCap::new(Vec3::Z, 4.0).is_err());
     }

@@ -31,7 +31,8 @@ pub fn normalize_or_zero(v: Vec3) -> Vec3 {
     if m == 0.0 {
         return Vec3::ZERO;
     }
-    let s = v * (1.0 / m);
+    // 1/m overflows for subnormal m; any large common factor keeps the direction.
+    let s = v * (1.0 / m).min(f32::MAX);
     s * (1.0 / math::sqrtf(s.dot(s)))
 }
 
@@ -109,7 +110,10 @@ mod tests {
             assert!((f.t.length() - 1.0).abs() < 1e-6);
             assert!((f.b.length() - 1.0).abs() < 1e-6);
             assert!(f.t.dot(f.n).abs() < 1e-6 && f.b.dot(f.n).abs() < 1e-6);
-            assert!((f.t.cross(f.b) - f.n).length() < 1e-6, "right-handed for {n}");
+            assert!(
+                (f.t.cross(f.b) - f.n).length() < 1e-6,
+                "right-handed for {n}"
+            );
         }
     }
 

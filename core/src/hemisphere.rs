@@ -36,7 +36,8 @@ pub const UNMAP_ABS_ERROR: f32 = 3.0e-7;
 #[inline]
 pub fn map(dir: Vec3) -> Vec2 {
     let m = dir.x.abs().max(dir.y.abs()).max(dir.z.abs());
-    let r = 1.0 / m;
+    // 1/m overflows for subnormal m; any large common factor keeps the direction.
+    let r = (1.0 / m).min(f32::MAX);
     let (x, y, z) = (dir.x * r, dir.y * r, dir.z * r);
     let inv_len = 1.0 / math::sqrtf(x * x + y * y + z * z);
     let zn = z.abs() * inv_len;
@@ -129,6 +130,9 @@ mod tests {
         assert_eq!(map(-Vec3::Z), Vec2::ZERO);
         assert!(map(Vec3::new(f32::NAN, 0.0, 1.0)).x.is_nan());
         assert!(map(Vec3::new(f32::INFINITY, 0.0, 1.0)).is_nan());
+        // subnormal components: the reciprocal of the largest saturates, no NaN
+        let s = map(Vec3::new(1e-45, 0.0, 1e-45));
+        assert!((s - map(Vec3::new(1.0, 0.0, 1.0))).length() < 1e-6, "{s}");
         // unmap clamps outside the disk onto the horizon
         let d = unmap(Vec2::new(3.0, 4.0));
         assert!((d - Vec3::new(0.6, 0.8, 0.0)).length() < 1e-6);
@@ -144,7 +148,10 @@ mod tests {
             for i in 0..n {
                 let d = texel_center_dir(i, j, n);
                 assert!((d.length() - 1.0).abs() < 1e-6 && d.z >= 0.0);
-                let p = uv_to_disk(Vec2::new((i as f32 + 0.5) / n as f32, (j as f32 + 0.5) / n as f32));
+                let p = uv_to_disk(Vec2::new(
+                    (i as f32 + 0.5) / n as f32,
+                    (j as f32 + 0.5) / n as f32,
+                ));
                 if p.length() < 1.0 {
                     inside += 1;
                     assert_eq!(dir_to_texel(d, n), (i, j));

@@ -37,6 +37,10 @@ mod imp {
     pub fn floorf(x: f32) -> f32 {
         x.floor()
     }
+    #[inline(always)]
+    pub fn ceilf(x: f32) -> f32 {
+        x.ceil()
+    }
 }
 
 #[cfg(all(not(feature = "std"), feature = "libm"))]
@@ -73,6 +77,10 @@ mod imp {
     pub fn floorf(x: f32) -> f32 {
         libm::floorf(x)
     }
+    #[inline(always)]
+    pub fn ceilf(x: f32) -> f32 {
+        libm::ceilf(x)
+    }
 }
 
 #[cfg(not(any(feature = "std", feature = "libm")))]
@@ -100,6 +108,9 @@ mod imp {
         x
     }
     pub fn floorf(x: f32) -> f32 {
+        x
+    }
+    pub fn ceilf(x: f32) -> f32 {
         x
     }
 }

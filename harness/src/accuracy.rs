@@ -9,7 +9,7 @@ use crate::reference;
 pub fn metric(kernel: Kernel) -> &'static str {
     match kernel {
         Kernel::HemisphereMap | Kernel::HemisphereUnmap => "abs",
-        Kernel::LobeEval => "rel/(1+|ln(c/s)|)",
+        Kernel::LobeEval => "rel/κ",
         Kernel::LobeIntegral => "rel",
         Kernel::CapExponent => "excess-L2-rel",
     }
@@ -25,6 +25,26 @@ pub fn bound(kernel: Kernel) -> f64 {
         Kernel::LobeIntegral => lobe::INTEGRAL_REL_ERROR as f64,
         Kernel::CapExponent => cap::EXCESS_L2_REL,
     }
+}
+
+/// The lobe-eval metric `|c − c*| / (|c*|·κ)` with
+/// `κ = 1 + |ln(c*/s)| + (EVAL_DOT_ERROR/EVAL_REL_ERROR)·e/(a·v)`, so that the documented
+/// bound of `steradian_core::lobe` reads `metric ≤ EVAL_REL_ERROR`. Where `c*` is below
+/// `1e-30·|s|` (f32 cannot hold it relative to `s`) it is the absolute error over `|s|`.
+pub fn lobe_eval_error(axis: [f32; 3], s: f32, e: f32, v: [f32; 3], got: f64) -> f64 {
+    use steradian_core::lobe::{EVAL_DOT_ERROR, EVAL_REL_ERROR};
+    let want = reference::lobe_eval(axis, s, e, v);
+    let s = s as f64;
+    if want.abs() < 1e-30 * s.abs() || want == 0.0 {
+        return (got - want).abs() / s.abs().max(f64::MIN_POSITIVE);
+    }
+    let (Some(a), Some(v)) = (reference::normalize(axis), reference::normalize(v)) else {
+        return f64::INFINITY;
+    };
+    let d = a[0] * v[0] + a[1] * v[1] + a[2] * v[2];
+    let e = (e as f64).max(0.0);
+    let kappa = 1.0 + (want / s).ln().abs() + (EVAL_DOT_ERROR / EVAL_REL_ERROR) as f64 * e / d;
+    (got - want).abs() / (want.abs() * kappa)
 }
 
 /// Reference data for the first `rows` rows of a batch (computed once, compared against
@@ -74,17 +94,16 @@ pub fn row_error(r: &Reference, input: &Columns, out: &Columns, i: usize) -> f64
             .map(|(g, w)| (g - w).abs())
             .fold(0.0, f64::max),
         Kernel::LobeEval => {
-            let s = input.row(i)[3] as f64;
-            let (g, w) = (got[0], want[0]);
-            if w.abs() < 1e-30 * s.abs() {
-                (g - w).abs() / s.abs()
-            } else {
-                (g - w).abs() / (w.abs() * (1.0 + (w / s).ln().abs()))
-            }
+            let r = input.row(i);
+            lobe_eval_error([r[0], r[1], r[2]], r[3], r[4], [r[5], r[6], r[7]], got[0])
         }
         Kernel::LobeIntegral => {
             let (g, w) = (got[0], want[0]);
-            if w == 0.0 { g.abs() } else { ((g - w) / w).abs() }
+            if w == 0.0 {
+                g.abs()
+            } else {
+                ((g - w) / w).abs()
+            }
         }
         Kernel::CapExponent => {
             let a = input.row(i)[0] as f64;
@@ -122,11 +141,11 @@ pub fn stats(r: &Reference, input: &Columns, out: &Columns) -> ErrorStats {
     let mut errs: Vec<f64> = (0..r.values.len())
         .map(|i| row_error(r, input, out, i))
         .collect();
-    let (argmax, max) = errs
-        .iter()
-        .copied()
-        .enumerate()
-        .fold((0, 0.0), |(bi, b), (i, e)| if e > b { (i, e) } else { (bi, b) });
+    let (argmax, max) =
+        errs.iter().copied().enumerate().fold(
+            (0, 0.0),
+            |(bi, b), (i, e)| if e > b { (i, e) } else { (bi, b) },
+        );
     let mean = errs.iter().sum::<f64>() / errs.len().max(1) as f64;
     errs.sort_by(f64::total_cmp);
     let p99 = errs

@@ -9,7 +9,7 @@ use steradian_core::cap::{self, CapFit, SphericalCap};
 use steradian_core::frame::Frame;
 use steradian_core::lobe::{self, CosineLobe, Lafortune, LafortuneLobe, Phong};
 use steradian_core::{Vec2, Vec3, hemisphere};
-use steradian_harness::reference;
+use steradian_harness::{accuracy, reference};
 
 fn config() -> Config {
     Config {
@@ -44,7 +44,9 @@ fn unit(v: [f64; 3]) -> [f32; 3] {
 fn map_err(d: [f32; 3]) -> f64 {
     let got = hemisphere::map(Vec3::from(d));
     let want = reference::hemisphere_map(d);
-    (got.x as f64 - want[0]).abs().max((got.y as f64 - want[1]).abs())
+    (got.x as f64 - want[0])
+        .abs()
+        .max((got.y as f64 - want[1]).abs())
 }
 
 fn unmap_err(p: [f32; 2]) -> f64 {
@@ -57,16 +59,10 @@ fn unmap_err(p: [f32; 2]) -> f64 {
         .fold(0.0, f64::max)
 }
 
-/// The lobe-eval metric: relative error per unit of `1 + |ln(c/s)|`.
+/// The lobe-eval metric (see `accuracy::lobe_eval_error`).
 fn lobe_err(axis: [f32; 3], s: f32, e: f32, v: [f32; 3]) -> f64 {
     let got = lobe::eval(Vec3::from(axis), s, e, Vec3::from(v)) as f64;
-    let want = reference::lobe_eval(axis, s, e, v);
-    let s = s as f64;
-    if want.abs() < 1e-30 * s.abs() {
-        (got - want).abs() / s.abs()
-    } else {
-        (got - want).abs() / (want.abs() * (1.0 + (want / s).ln().abs()))
-    }
+    accuracy::lobe_eval_error(axis, s, e, v, got)
 }
 
 fn cap_excess(a: f32) -> f64 {
@@ -181,14 +177,28 @@ fn hard_case_map_pole_horizon_and_grazing() {
         ("subnormal", [1e-45, 0.0, 1e-45]),
         ("below horizon", [0.3, 0.4, -0.5]),
     ] {
-        assert!(map_err(d) <= hemisphere::MAP_ABS_ERROR as f64, "{name}: {}", map_err(d));
+        assert!(
+            map_err(d) <= hemisphere::MAP_ABS_ERROR as f64,
+            "{name}: {}",
+            map_err(d)
+        );
     }
-    assert_eq!(hemisphere::map(Vec3::ZERO), Vec2::ZERO, "zero vector → pole");
+    assert_eq!(
+        hemisphere::map(Vec3::ZERO),
+        Vec2::ZERO,
+        "zero vector → pole"
+    );
 }
 
 #[test]
 fn hard_case_unmap_horizon() {
-    for p in [[1.0f32, 0.0], [0.0, -1.0], [0.70710677, 0.70710677], [0.99999994, 0.0], [0.0, 0.0]] {
+    for p in [
+        [1.0f32, 0.0],
+        [0.0, -1.0],
+        [0.70710677, 0.70710677],
+        [0.99999994, 0.0],
+        [0.0, 0.0],
+    ] {
         assert!(unmap_err(p) <= hemisphere::UNMAP_ABS_ERROR as f64, "{p:?}");
     }
 }
@@ -196,10 +206,20 @@ fn hard_case_unmap_horizon() {
 #[test]
 fn hard_case_lobe_exponent_zero_and_1e5() {
     let z = [0.0f32, 0.0, 1.0];
-    for (e, theta) in [(0.0f32, 1.0f64), (0.0, 1.5), (1e5, 0.0), (1e5, 1e-3), (1e5, 3e-3), (1e5, 1e-2)] {
+    for (e, theta) in [
+        (0.0f32, 1.0f64),
+        (0.0, 1.5),
+        (1e5, 0.0),
+        (1e5, 1e-3),
+        (1e5, 3e-3),
+        (1e5, 1e-2),
+    ] {
         let v = unit([theta.sin(), 0.0, theta.cos()]);
         let err = lobe_err(z, 1.0, e, v);
-        assert!(err <= lobe::EVAL_REL_ERROR as f64, "e = {e}, θ = {theta}: {err}");
+        assert!(
+            err <= lobe::EVAL_REL_ERROR as f64,
+            "e = {e}, θ = {theta}: {err}"
+        );
     }
     // A plain powf(a·v, e) loses about e·2⁻²⁴ relative at 1e5; the kernel does not.
     let v = unit([(3e-3f64).sin(), 0.0, (3e-3f64).cos()]);
@@ -208,17 +228,35 @@ fn hard_case_lobe_exponent_zero_and_1e5() {
     let ours = lobe::eval(Vec3::from(z), 1.0, 1e5, Vec3::from(v)) as f64;
     assert!((ours / want - 1.0).abs() < (naive / want - 1.0).abs());
     // The integral of the e = 0 lobe is the hemisphere's 2π.
-    assert_eq!(CosineLobe::new(Vec3::Z, 1.0, 0.0).unwrap().integral(), steradian_core::TWO_PI);
+    assert_eq!(
+        CosineLobe::new(Vec3::Z, 1.0, 0.0).unwrap().integral(),
+        steradian_core::TWO_PI
+    );
 }
 
 #[test]
 fn hard_case_tiny_caps_and_hemisphere() {
-    for a in [1e-4f32, 1e-6, 1e-12, 1e-18, FRAC_PI_2 as f32, FRAC_PI_2 as f32 - 1e-6, 1.0] {
-        assert!(cap_excess(a) <= cap::EXCESS_L2_REL, "α = {a}: {}", cap_excess(a));
+    for a in [
+        1e-4f32,
+        1e-6,
+        1e-12,
+        1e-18,
+        FRAC_PI_2 as f32,
+        FRAC_PI_2 as f32 - 1e-6,
+        1.0,
+    ] {
+        assert!(
+            cap_excess(a) <= cap::EXCESS_L2_REL,
+            "α = {a}: {}",
+            cap_excess(a)
+        );
     }
     // e ≈ 2k*/α² for tiny caps
     let e = cap::exponent_l2(1e-4) as f64;
-    assert!((e * 1e-8 / (2.0 * reference::cap::k_star()) - 1.0).abs() < 1e-5, "{e}");
+    assert!(
+        (e * 1e-8 / (2.0 * reference::cap::k_star()) - 1.0).abs() < 1e-5,
+        "{e}"
+    );
 }
 
 #[test]
@@ -235,8 +273,16 @@ fn energy_preserving_cap_lobe_integral_is_the_solid_angle() {
 fn lafortune_lobes_equal_the_brdf() {
     let frame = Frame::from_normal_tangent(Vec3::new(0.1, 0.2, 1.0), Vec3::X).unwrap();
     let lobes = [
-        LafortuneLobe { c: Vec3::new(-0.8, -0.5, 0.9), exponent: 12.0, rho: 0.7 },
-        LafortuneLobe { c: Vec3::new(0.3, 0.3, 0.6), exponent: 1.5, rho: 0.2 },
+        LafortuneLobe {
+            c: Vec3::new(-0.8, -0.5, 0.9),
+            exponent: 12.0,
+            rho: 0.7,
+        },
+        LafortuneLobe {
+            c: Vec3::new(0.3, 0.3, 0.6),
+            exponent: 1.5,
+            rho: 0.2,
+        },
     ];
     let brdf = Lafortune::new(lobes).unwrap();
     let wo = Vec3::new(0.4, -0.3, 0.8).normalize();
@@ -244,16 +290,70 @@ fn lafortune_lobes_equal_the_brdf() {
     let wl = frame.to_local(wo);
     for i in 0..200 {
         let t = i as f32 * 0.37;
-        let v = Vec3::new(t.sin() * (t * 0.7).cos(), t.sin() * (t * 0.7).sin(), t.cos()).normalize();
+        let v = Vec3::new(
+            t.sin() * (t * 0.7).cos(),
+            t.sin() * (t * 0.7).sin(),
+            t.cos(),
+        )
+        .normalize();
         let vl = frame.to_local(v);
         let want: f64 = lobes
             .iter()
             .map(|l| {
-                let d = (vl * l.c * wl).to_array().iter().map(|x| *x as f64).sum::<f64>();
+                let d = (vl * l.c * wl)
+                    .to_array()
+                    .iter()
+                    .map(|x| *x as f64)
+                    .sum::<f64>();
                 l.rho as f64 * d.max(0.0).powf(l.exponent as f64)
             })
             .sum();
         let got: f64 = ls.iter().map(|l| l.eval(v) as f64).sum();
         assert!((got - want).abs() < 1e-5, "{v}: {got} vs {want}");
     }
+}
+
+/// Every f32 half-angle from `MIN_HALF_ANGLE` to π/2 (every 64th in debug builds): the
+/// looked-up exponent is finite, non-negative and never increases.
+#[test]
+fn cap_exponent_monotone_over_every_f32() {
+    let step = if cfg!(debug_assertions) { 64 } else { 1 };
+    let (lo, hi) = (cap::MIN_HALF_ANGLE.to_bits(), (FRAC_PI_2 as f32).to_bits());
+    let mut prev = f32::INFINITY;
+    let mut bits = lo;
+    while bits <= hi {
+        let a = f32::from_bits(bits);
+        let e = cap::exponent_l2(a);
+        assert!(
+            e.is_finite() && e >= 0.0 && e <= prev,
+            "α = {a:e}: {e} after {prev}"
+        );
+        prev = e;
+        bits += step;
+    }
+}
+
+/// Every f32 within 2e-3 rad of the hemisphere (every 16th in debug builds), where
+/// `e* ≈ c(1 − ln c)/2` has its logarithmic kink: the excess objective stays within bound.
+#[test]
+fn cap_exponent_every_f32_next_to_the_hemisphere() {
+    let step = if cfg!(debug_assertions) { 16 } else { 1 };
+    let hi = (FRAC_PI_2 as f32).to_bits();
+    let lo = (FRAC_PI_2 as f32 - 2e-3).to_bits();
+    let mut worst = (0.0, 0.0f32);
+    let mut bits = lo;
+    while bits <= hi {
+        let a = f32::from_bits(bits);
+        let x = cap_excess(a);
+        if x > worst.0 {
+            worst = (x, a);
+        }
+        bits += step;
+    }
+    assert!(
+        worst.0 <= cap::EXCESS_L2_REL,
+        "worst excess {:e} at α = {}",
+        worst.0,
+        worst.1
+    );
 }
