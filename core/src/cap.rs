@@ -191,7 +191,7 @@ impl SphericalCap {
             0.0
         };
         let sin_a = (radius / m) / unit_len;
-        if m == 0.0 || !(sin_a < 1.0) {
+        if m == 0.0 || sin_a.is_nan() || sin_a >= 1.0 {
             return Err(Error::InsideSphere {
                 distance: m * unit_len,
                 radius,

@@ -36,8 +36,9 @@ pub const UNMAP_ABS_ERROR: f32 = 3.0e-7;
 #[inline]
 pub fn map(dir: Vec3) -> Vec2 {
     let m = dir.x.abs().max(dir.y.abs()).max(dir.z.abs());
-    // 1/m overflows for subnormal m; any large common factor keeps the direction.
-    let r = (1.0 / m).min(f32::MAX);
+    // Any common factor keeps the direction: clamping 1/m to the normal range avoids its
+    // overflow for subnormal m and its subnormal (flushed under FTZ) value for m > 2¹²⁶.
+    let r = (1.0 / m).clamp(f32::MIN_POSITIVE, f32::MAX);
     let (x, y, z) = (dir.x * r, dir.y * r, dir.z * r);
     let inv_len = 1.0 / math::sqrtf(x * x + y * y + z * z);
     let zn = z.abs() * inv_len;
@@ -56,8 +57,11 @@ pub fn map(dir: Vec3) -> Vec2 {
 pub fn unmap(p: Vec2) -> Vec3 {
     let r2 = p.x * p.x + p.y * p.y;
     let (px, py, r2) = if r2 > 1.0 {
-        let k = 1.0 / math::sqrtf(r2);
-        (p.x * k, p.y * k, 1.0)
+        // Scale by the larger component first so |p| beyond 1.8e19 does not overflow.
+        let m = p.x.abs().max(p.y.abs());
+        let (qx, qy) = (p.x / m, p.y / m);
+        let k = 1.0 / math::sqrtf(qx * qx + qy * qy);
+        (qx * k, qy * k, 1.0)
     } else {
         (p.x, p.y, r2)
     };
@@ -137,6 +141,10 @@ mod tests {
         let d = unmap(Vec2::new(3.0, 4.0));
         assert!((d - Vec3::new(0.6, 0.8, 0.0)).length() < 1e-6);
         assert!(unmap(Vec2::new(f32::NAN, 0.0)).is_nan());
+        let far = unmap(Vec2::new(3e30, -4e30));
+        assert!((far - Vec3::new(0.6, -0.8, 0.0)).length() < 1e-6, "{far}");
+        let big = map(Vec3::new(3e38, 1e38, 2e38));
+        assert!((big - map(Vec3::new(3.0, 1.0, 2.0))).length() < 1e-6, "{big}");
         assert!(unmap(Vec2::new(f32::INFINITY, 0.0)).is_nan());
     }
 

@@ -405,7 +405,10 @@ mod tests {
             TableView::parse(&good[..good.len() - 1]).unwrap_err(),
             TableError::Truncated
         );
-        assert_eq!(TableView::parse(&good[..10]).unwrap_err(), TableError::Truncated);
+        assert_eq!(
+            TableView::parse(&good[..10]).unwrap_err(),
+            TableError::Truncated
+        );
         // every single-byte change anywhere is rejected
         for at in 0..good.len() {
             let mut b = good;

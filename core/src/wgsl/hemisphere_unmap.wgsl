@@ -25,10 +25,14 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     var py = input[n + i];
     var r2 = px * px + py * py;
     // Points outside the disk are clamped radially onto the unit circle (the horizon).
+    // Scale by the larger component first, as the scalar kernel does.
     if (r2 > 1.0) {
-        let k = 1.0 / sqrt(r2);
-        px = px * k;
-        py = py * k;
+        let m = max(abs(px), abs(py));
+        let qx = px / m;
+        let qy = py / m;
+        let k = 1.0 / sqrt(qx * qx + qy * qy);
+        px = qx * k;
+        py = qy * k;
         r2 = 1.0;
     }
     let s = sqrt(2.0 - r2);

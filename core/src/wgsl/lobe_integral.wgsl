@@ -28,5 +28,6 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     let scale = input[n + i];
     // A negative exponent is clamped to 0.
     let e = select(exponent, 0.0, exponent < 0.0);
-    output[i] = TWO_PI * scale / (e + 1.0);
+    // Divide first, as the scalar kernel does (2π·s overflows for |s| > 5.4e37).
+    output[i] = TWO_PI * (scale / (e + 1.0));
 }
