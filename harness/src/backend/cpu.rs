@@ -40,6 +40,7 @@ fn bb<T>(x: T, opaque: bool) -> T {
     if opaque { black_box(x) } else { x }
 }
 
+#[allow(clippy::needless_range_loop)] // one index walks several columns
 /// Runs the scalar kernel over every row. With `opaque`, each input and output goes
 /// through `black_box` so the compiler cannot vectorise across rows.
 #[inline(always)]
