@@ -7,7 +7,11 @@ use clap::{Parser, Subcommand};
 use steradian_harness::{eval, generate, report};
 
 #[derive(Parser)]
-#[command(name = "steradian", version, about = "Fast, accurate spherical lighting integrals: report, eval, tables")]
+#[command(
+    name = "steradian",
+    version,
+    about = "Fast, accurate spherical lighting integrals: report, eval, tables"
+)]
 struct Cli {
     #[command(subcommand)]
     command: Command,

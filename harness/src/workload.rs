@@ -95,9 +95,7 @@ fn random_row(kernel: Kernel, r: &mut Rng) -> Vec<f32> {
             let (u, w) = perpendiculars(a);
             let phi = r.range(0.0, std::f64::consts::TAU);
             let dir: Vec<f64> = (0..3)
-                .map(|i| {
-                    theta.cos() * a[i] + theta.sin() * (phi.cos() * u[i] + phi.sin() * w[i])
-                })
+                .map(|i| theta.cos() * a[i] + theta.sin() * (phi.cos() * u[i] + phi.sin() * w[i]))
                 .collect();
             let s = r.range(0.1, 10.0);
             let an = unit32(&a);
@@ -115,7 +113,11 @@ fn unit32(v: &[f64]) -> [f32; 3] {
 }
 
 fn perpendiculars(a: [f64; 3]) -> ([f64; 3], [f64; 3]) {
-    let t = if a[0].abs() < 0.9 { [1.0, 0.0, 0.0] } else { [0.0, 1.0, 0.0] };
+    let t = if a[0].abs() < 0.9 {
+        [1.0, 0.0, 0.0]
+    } else {
+        [0.0, 1.0, 0.0]
+    };
     let cross = |p: [f64; 3], q: [f64; 3]| {
         [
             p[1] * q[2] - p[2] * q[1],

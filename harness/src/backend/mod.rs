@@ -32,8 +32,12 @@ pub trait Backend {
 
     /// Runs `kernel` over `input` (`kernel.input_arity()` columns) into `out`
     /// (`kernel.output_arity()` columns of the same length).
-    fn run(&mut self, kernel: Kernel, input: &Columns, out: &mut Columns)
-    -> Result<(), BackendError>;
+    fn run(
+        &mut self,
+        kernel: Kernel,
+        input: &Columns,
+        out: &mut Columns,
+    ) -> Result<(), BackendError>;
 }
 
 /// Checks the shapes of a batch; every backend calls it first.
@@ -47,7 +51,10 @@ pub fn check_shapes(kernel: Kernel, input: &Columns, out: &Columns) -> Result<()
             out.arity
         )));
     }
-    if input.n != out.n || input.data.len() != input.n * input.arity || out.data.len() != out.n * out.arity {
+    if input.n != out.n
+        || input.data.len() != input.n * input.arity
+        || out.data.len() != out.n * out.arity
+    {
         return Err(BackendError(format!("{kernel}: column lengths disagree")));
     }
     Ok(())

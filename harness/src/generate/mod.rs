@@ -74,7 +74,11 @@ mod tests {
     fn committed_tables_match_generators() {
         let r = run(&default_dir(), true).unwrap();
         for o in r {
-            assert!(o.matches, "{} differs from a fresh generation: run `steradian tables`", o.file);
+            assert!(
+                o.matches,
+                "{} differs from a fresh generation: run `steradian tables`",
+                o.file
+            );
         }
     }
 }

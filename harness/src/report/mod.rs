@@ -206,7 +206,11 @@ pub fn summary(r: &Report) -> String {
         r.machine
             .gpu_adapter
             .clone()
-            .or_else(|| r.machine.gpu_unavailable.clone().map(|w| format!("none ({w})")))
+            .or_else(|| r
+                .machine
+                .gpu_unavailable
+                .clone()
+                .map(|w| format!("none ({w})")))
             .unwrap_or_else(|| "not tried".into())
     );
     s += &format!(
@@ -231,7 +235,9 @@ pub fn summary(r: &Report) -> String {
 }
 
 fn esc(s: &str) -> String {
-    s.replace('&', "&amp;").replace('<', "&lt;").replace('>', "&gt;")
+    s.replace('&', "&amp;")
+        .replace('<', "&lt;")
+        .replace('>', "&gt;")
 }
 
 fn html(r: &Report) -> String {

@@ -54,10 +54,16 @@ pub fn speed_vs_error(r: &Report) -> String {
         let ys: Vec<f64> = pts
             .iter()
             .map(|p| {
-                let e = if p.error.max.is_finite() { p.error.max } else { 1.0 };
+                let e = if p.error.max.is_finite() {
+                    p.error.max
+                } else {
+                    1.0
+                };
                 e.max(FLOOR).log10()
             })
-            .chain(std::iter::once(pts.first().map_or(0.0, |p| p.bound.max(FLOOR).log10())))
+            .chain(std::iter::once(
+                pts.first().map_or(0.0, |p| p.bound.max(FLOOR).log10()),
+            ))
             .collect();
         let (x0, x1) = (
             xs.iter().copied().fold(f64::INFINITY, f64::min).floor(),
