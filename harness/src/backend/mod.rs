@@ -4,7 +4,7 @@
 //! |---|---|
 //! | `cpu-scalar` | the scalar kernel called one input at a time, each input behind `black_box`, the way a renderer calls it per shading point |
 //! | `cpu-scalar-loop` | a plain loop over the scalar kernel, which LLVM may vectorise |
-//! | `cpu-simd` | the explicit 8-lane batch of `steradian-simd` |
+//! | `cpu-simd` | the explicit batch of `steradian-simd` (8 lanes; its slice functions use 16 on AVX-512 builds) |
 //! | `wgpu` | the WGSL kernel on a GPU adapter (upload, dispatch and read-back included) |
 
 use crate::kernels::{Columns, Kernel};
