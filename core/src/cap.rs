@@ -90,14 +90,16 @@ pub fn lookup(table: &[f32], half_angle: f32) -> f32 {
     let u = ((FRAC_PI_2 - a) + FRAC_PI_2_LO).max(0.0);
     let r = (math::sqrtf(u * (2.0 / core::f32::consts::PI)) * last).min(last);
     let k = math::ceilf(r).max(1.0);
-    let i = (last - k) as usize;
+    // `min` only matters for tables beyond 2²⁴ samples, where `last` rounds up.
+    let i = ((last - k) as usize).min(n - 2);
     let f = ((k - r) * (k + r) / (2.0 * k - 1.0)).min(1.0);
     let (h0, h1) = (table[i], table[i + 1]);
     (h0 + f * (h1 - h0)) / (a * a)
 }
 
-/// `π/2 − FRAC_PI_2` (the f32 constant rounds π/2 up by this much).
-const FRAC_PI_2_LO: f32 = -4.371_139e-8;
+/// `π/2 − FRAC_PI_2`: the f32 constant rounds π/2 up by this much; `(FRAC_PI_2 − α) +
+/// FRAC_PI_2_LO` is `π/2 − α` to a few ulps even next to the hemisphere.
+pub const FRAC_PI_2_LO: f32 = -4.371_139e-8;
 
 /// `1 − cos α` without cancellation: `2·sin²(α/2)`.
 #[inline]
@@ -262,6 +264,16 @@ mod tests {
         assert!(exponent_l2(f32::NEG_INFINITY).is_finite());
         let tiny = exponent_l2(1e-4);
         assert!((tiny / 1.9226e8 - 1.0).abs() < 1e-3, "{tiny}");
+    }
+
+    #[test]
+    fn huge_user_tables_do_not_panic() {
+        extern crate std;
+        let t = std::vec![1.0f32; (1 << 24) + 4];
+        for a in [0.0, 1.0, FRAC_PI_2, 3.0] {
+            assert!(lookup(&t, a).is_finite());
+        }
+        assert!(lookup(&[1.0], 0.5).is_nan() && lookup(&[], 0.5).is_nan());
     }
 
     #[test]

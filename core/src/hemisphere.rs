@@ -44,7 +44,9 @@ pub fn map(dir: Vec3) -> Vec2 {
     let zn = z.abs() * inv_len;
     let s = inv_len / math::sqrtf(1.0 + zn);
     if m == 0.0 {
-        Vec2::ZERO
+        // The zero vector → the pole; `m` ignores NaN, so keep a NaN component visible.
+        let z0 = (dir.x + dir.y + dir.z) * 0.0;
+        Vec2::new(z0, z0)
     } else {
         Vec2::new(x * s, y * s)
     }
@@ -133,6 +135,8 @@ mod tests {
         assert_eq!(a, b);
         assert_eq!(map(-Vec3::Z), Vec2::ZERO);
         assert!(map(Vec3::new(f32::NAN, 0.0, 1.0)).x.is_nan());
+        assert!(map(Vec3::new(f32::NAN, 0.0, 0.0)).is_nan());
+        assert!(map(Vec3::new(0.0, 0.0, f32::NAN)).is_nan());
         assert!(map(Vec3::new(f32::INFINITY, 0.0, 1.0)).is_nan());
         // subnormal components: the reciprocal of the largest saturates, no NaN
         let s = map(Vec3::new(1e-45, 0.0, 1e-45));
@@ -144,7 +148,10 @@ mod tests {
         let far = unmap(Vec2::new(3e30, -4e30));
         assert!((far - Vec3::new(0.6, -0.8, 0.0)).length() < 1e-6, "{far}");
         let big = map(Vec3::new(3e38, 1e38, 2e38));
-        assert!((big - map(Vec3::new(3.0, 1.0, 2.0))).length() < 1e-6, "{big}");
+        assert!(
+            (big - map(Vec3::new(3.0, 1.0, 2.0))).length() < 1e-6,
+            "{big}"
+        );
         assert!(unmap(Vec2::new(f32::INFINITY, 0.0)).is_nan());
     }
 

@@ -112,8 +112,9 @@ impl CosineLobe {
     }
 }
 
-/// `s·max(a·v, 0)^e` for unit `a` and `v`, as `s·exp(e·log1p(−|a − v|²/2))`; 0 where
-/// `a·v ≤ 0`. A negative exponent is clamped to 0; NaN in any input gives NaN.
+/// `s·max(a·v, 0)^e` for unit `a` and `v`, as `s·exp(e·log1p(−|a − v|²/2))`; `0·s` where
+/// `a·v ≤ 0` (whatever the exponent). A negative exponent is clamped to 0; NaN in the axis,
+/// the direction or the scale gives NaN, and so does a NaN exponent above the horizon.
 #[inline]
 pub fn eval(axis: Vec3, scale: f32, exponent: f32, v: Vec3) -> f32 {
     let exponent = if exponent < 0.0 { 0.0 } else { exponent };

@@ -109,9 +109,12 @@ pub fn speed_vs_error(r: &Report) -> String {
         }
         s += &format!(
             r##"<text x="{}" y="{}" text-anchor="middle" fill="#555">evals/s</text>
+<text transform="translate({},{}) rotate(-90)" text-anchor="middle" fill="#555">max error</text>
 "##,
             l + pw2 / 2.0,
-            t + ph2 + 27.0
+            t + ph2 + 27.0,
+            ox + 10.0,
+            t + ph2 / 2.0
         );
         if let Some(p) = pts.first() {
             let by = py(p.bound.max(FLOOR).log10());
