@@ -11,7 +11,7 @@ use indicatif::{ProgressBar, ProgressStyle};
 use serde::Serialize;
 
 use crate::accuracy::{self, ErrorStats};
-use crate::backend::{self, Backend};
+use crate::backend;
 use crate::kernels::{Columns, Kernel};
 use crate::workload;
 
@@ -110,24 +110,6 @@ fn cpu_name() -> String {
         .unwrap_or_else(|| std::env::consts::ARCH.to_string())
 }
 
-fn time_median(
-    b: &mut dyn Backend,
-    k: Kernel,
-    input: &Columns,
-    out: &mut Columns,
-    repeats: usize,
-) -> Result<Duration, backend::BackendError> {
-    b.run(k, input, out)?; // warm-up (and pipeline creation on the GPU)
-    let mut times = Vec::with_capacity(repeats);
-    for _ in 0..repeats.max(1) {
-        let t = Instant::now();
-        b.run(k, input, out)?;
-        times.push(t.elapsed());
-    }
-    times.sort();
-    Ok(times[times.len() / 2])
-}
-
 /// Runs the report and writes `report.json` and `index.html` into `opts.out`.
 pub fn run(opts: &Options) -> Result<Report, Box<dyn std::error::Error>> {
     let mut backends = backend::cpu_backends();
@@ -158,24 +140,47 @@ pub fn run(opts: &Options) -> Result<Report, Box<dyn std::error::Error>> {
         let input = workload::generate(k, opts.n, SEED);
         let reference = accuracy::reference(k, &input, opts.error_rows);
         bar.inc(1);
-        for b in backends.iter_mut() {
-            bar.set_message(format!("{k} on {}", b.name()));
-            let mut out = Columns::zeros(k.output_arity(), opts.n);
-            match time_median(b.as_mut(), k, &input, &mut out, opts.repeats) {
-                Ok(t) => {
-                    let error = accuracy::stats(&reference, &input, &out);
-                    let bound = accuracy::bound(k);
-                    results.push(Row {
-                        kernel: k.name(),
-                        backend: b.name(),
-                        evals_per_s: opts.n as f64 / t.as_secs_f64().max(1e-12),
-                        n: opts.n,
-                        within_bound: error.max <= bound,
-                        error,
-                        bound,
-                    });
+        // Backends take turns within each repeat, so a noisy machine slows them alike and
+        // the ratios between them stay meaningful.
+        let mut outs: Vec<Columns> = backends
+            .iter()
+            .map(|_| Columns::zeros(k.output_arity(), opts.n))
+            .collect();
+        let mut times: Vec<Vec<Duration>> = vec![Vec::new(); backends.len()];
+        let mut failed: Vec<Option<String>> = vec![None; backends.len()];
+        for rep in 0..=opts.repeats.max(1) {
+            for (bi, b) in backends.iter_mut().enumerate() {
+                if failed[bi].is_some() {
+                    continue;
                 }
-                Err(e) => bar.println(format!("{k} on {}: {e}", b.name())),
+                bar.set_message(format!("{k} on {} ({rep}/{})", b.name(), opts.repeats));
+                let t = Instant::now();
+                match b.run(k, &input, &mut outs[bi]) {
+                    // The first round warms caches and compiles GPU pipelines.
+                    Ok(()) if rep > 0 => times[bi].push(t.elapsed()),
+                    Ok(()) => {}
+                    Err(e) => failed[bi] = Some(e.to_string()),
+                }
+            }
+        }
+        for (bi, b) in backends.iter().enumerate() {
+            if let Some(e) = &failed[bi] {
+                bar.println(format!("{k} on {}: {e}", b.name()));
+            } else {
+                let ts = &mut times[bi];
+                ts.sort();
+                let t = ts[ts.len() / 2];
+                let error = accuracy::stats(&reference, &input, &outs[bi]);
+                let bound = accuracy::bound(k);
+                results.push(Row {
+                    kernel: k.name(),
+                    backend: b.name(),
+                    evals_per_s: opts.n as f64 / t.as_secs_f64().max(1e-12),
+                    n: opts.n,
+                    within_bound: error.max <= bound,
+                    error,
+                    bound,
+                });
             }
             bar.inc(1);
         }
@@ -230,6 +235,21 @@ pub fn summary(r: &Report) -> String {
             row.error.mean,
             if row.within_bound { "ok" } else { "EXCEEDED" }
         );
+    }
+    s += "\nSIMD against the scalar rows of the same run:\n";
+    for k in Kernel::ALL {
+        let get = |b| r.get(k.name(), b).map(|row| row.evals_per_s);
+        if let (Some(simd), Some(one), Some(lp)) =
+            (get("cpu-simd"), get("cpu-scalar"), get("cpu-scalar-loop"))
+        {
+            s += &format!(
+                "  {:<17} cpu-simd = {:>5.2}× cpu-scalar, {:>5.2}× cpu-scalar-loop (the plain loop is {:.1}× cpu-scalar)\n",
+                k.name(),
+                simd / one,
+                simd / lp,
+                lp / one
+            );
+        }
     }
     s
 }
