@@ -1,6 +1,8 @@
 //! WGSL sources of the GPU kernels, mirroring the scalar ones, as `pub const &str` so a
 //! renderer can embed them. Each source is one compute entry point `main` with
-//! `@workgroup_size(64)` reading storage buffers; see each constant for its bindings.
+//! `@workgroup_size(64)` reading storage buffers; see each constant for its bindings. The
+//! batch layout below is written once, in `wgsl/batch.wgsl`, and prepended to every source,
+//! so each constant is a complete shader.
 //!
 //! ## Bindings (identical for every kernel)
 //!
@@ -51,12 +53,18 @@
 /// (`m` the largest component) rather than `1/m`, which is subnormal — and may be flushed
 /// to zero on a GPU — for `m > 2¹²⁶`; the two differ by a common factor the normalisation
 /// removes. Tolerance: [`HEMISPHERE_MAP_ABS_TOL`].
-pub const HEMISPHERE_MAP: &str = include_str!("wgsl/hemisphere_map.wgsl");
+pub const HEMISPHERE_MAP: &str = concat!(
+    include_str!("wgsl/batch.wgsl"),
+    include_str!("wgsl/hemisphere_map.wgsl")
+);
 /// Inverse hemisphere map, disk point → unit direction (`hemisphere::unmap`).
 /// Input columns `[u, v]`, output `[x, y, z]`. Points with `|p|² > 1` are clamped onto
 /// the unit circle; `|p|` must stay below `1.8e19` so that `|p|²` is finite.
 /// Tolerance: [`HEMISPHERE_UNMAP_ABS_TOL`].
-pub const HEMISPHERE_UNMAP: &str = include_str!("wgsl/hemisphere_unmap.wgsl");
+pub const HEMISPHERE_UNMAP: &str = concat!(
+    include_str!("wgsl/batch.wgsl"),
+    include_str!("wgsl/hemisphere_unmap.wgsl")
+);
 /// Cosine lobe `s·max(a·v, 0)^e` as `s·exp(e·log1p(−|a − v|²/2))`, 0 where
 /// `|a − v|²/2 ≥ 1` (`lobe::eval`). Input columns `[ax, ay, az, s, e, vx, vy, vz]`, output
 /// `[value]`.
@@ -75,17 +83,26 @@ pub const HEMISPHERE_UNMAP: &str = include_str!("wgsl/hemisphere_unmap.wgsl");
 /// `e = 0` exactly at `t = 1` (value `s` or 0), its results may then differ from the scalar
 /// kernel by more than the tolerance. Lavapipe does not fuse them.
 /// Tolerance: [`LOBE_EVAL_REL_TOL`].
-pub const LOBE_EVAL: &str = include_str!("wgsl/lobe_eval.wgsl");
+pub const LOBE_EVAL: &str = concat!(
+    include_str!("wgsl/batch.wgsl"),
+    include_str!("wgsl/lobe_eval.wgsl")
+);
 /// Exact lobe integral `2π·s/(e + 1)` (`lobe::integral`). Input columns `[e, s]`, output
 /// `[integral]`; `|2π·s|` and `e + 1` must stay below `2¹²⁶`.
 /// Tolerance: [`LOBE_INTEGRAL_ULP_TOL`].
-pub const LOBE_INTEGRAL: &str = include_str!("wgsl/lobe_integral.wgsl");
+pub const LOBE_INTEGRAL: &str = concat!(
+    include_str!("wgsl/batch.wgsl"),
+    include_str!("wgsl/lobe_integral.wgsl")
+);
 /// Cap → lobe L2 exponent looked up in the table of `h(α) = e*(α)·α²` (`cap::lookup`).
 /// Input column `[half_angle]`, output `[exponent]`; the table (`cap::TABLE`, or any table
 /// on the same grid) is the extra binding 3, its length read with `arrayLength`.
 /// The constants `2/π` and the two-part `π/2` are the f32 values the scalar kernel uses.
 /// Tolerance: [`CAP_EXPONENT_REL_TOL`] and [`CAP_EXPONENT_ABS_TOL`].
-pub const CAP_EXPONENT: &str = include_str!("wgsl/cap_exponent.wgsl");
+pub const CAP_EXPONENT: &str = concat!(
+    include_str!("wgsl/batch.wgsl"),
+    include_str!("wgsl/cap_exponent.wgsl")
+);
 
 /// Every kernel as `(name, source)`, the name as in the harness (`hemisphere-map`, …).
 pub const ALL: [(&str, &str); 5] = [

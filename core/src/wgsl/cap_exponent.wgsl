@@ -7,16 +7,6 @@
 // binding 3, N = arrayLength(&table) samples. Specified for finite inputs only; see
 // `steradian_core::wgsl`.
 
-struct Params {
-    n: u32,
-    row_stride: u32,
-    _pad0: u32,
-    _pad1: u32,
-}
-
-@group(0) @binding(0) var<storage, read> input: array<f32>;
-@group(0) @binding(1) var<storage, read_write> output: array<f32>;
-@group(0) @binding(2) var<uniform> params: Params;
 @group(0) @binding(3) var<storage, read> table: array<f32>;
 
 // `cap::MIN_HALF_ANGLE`: smaller (and negative) half-angles are clamped to it.
@@ -30,7 +20,7 @@ const TWO_OVER_PI: f32 = 0.63661975;
 
 @compute @workgroup_size(64)
 fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
-    let i = gid.x + gid.y * params.row_stride;
+    let i = batch_row(gid);
     let n = params.n;
     if (i >= n) {
         return;

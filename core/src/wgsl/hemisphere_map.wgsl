@@ -2,20 +2,9 @@
 // Input columns [x, y, z], output columns [u, v]; column c of a batch of n rows at c*n.
 // Specified for finite, normal (not subnormal) inputs only; see `steradian_core::wgsl`.
 
-struct Params {
-    n: u32,
-    row_stride: u32,
-    _pad0: u32,
-    _pad1: u32,
-}
-
-@group(0) @binding(0) var<storage, read> input: array<f32>;
-@group(0) @binding(1) var<storage, read_write> output: array<f32>;
-@group(0) @binding(2) var<uniform> params: Params;
-
 @compute @workgroup_size(64)
 fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
-    let i = gid.x + gid.y * params.row_stride;
+    let i = batch_row(gid);
     let n = params.n;
     if (i >= n) {
         return;

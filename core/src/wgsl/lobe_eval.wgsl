@@ -3,17 +3,6 @@
 // Input columns [ax, ay, az, s, e, vx, vy, vz], output column [value]; column c of a batch
 // of n rows at c*n. Specified for finite inputs only; see `steradian_core::wgsl`.
 
-struct Params {
-    n: u32,
-    row_stride: u32,
-    _pad0: u32,
-    _pad1: u32,
-}
-
-@group(0) @binding(0) var<storage, read> input: array<f32>;
-@group(0) @binding(1) var<storage, read_write> output: array<f32>;
-@group(0) @binding(2) var<uniform> params: Params;
-
 // log(1 + x) for x > -1. WGSL has no log1p, and the usual `log(u)*x/(u - 1)` with
 // u = 1 + x does not survive GPU compilers: they may fold (1 + x) - 1 into x (Mesa was seen to),
 // and WGSL's log only promises 2^-21 *absolute* error near 1 (lavapipe: ~1.6e-7), a
@@ -45,7 +34,7 @@ fn log1p(x: f32) -> f32 {
 
 @compute @workgroup_size(64)
 fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
-    let i = gid.x + gid.y * params.row_stride;
+    let i = batch_row(gid);
     let n = params.n;
     if (i >= n) {
         return;
