@@ -3,6 +3,7 @@
 //! crate so results (and the generated tables) are the same on every machine.
 
 pub mod cap;
+pub mod product;
 
 use std::f64::consts::{PI, TAU};
 
