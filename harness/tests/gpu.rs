@@ -38,16 +38,12 @@ fn gpu() -> Option<Gpu> {
     }
 }
 
-/// splitmix64: deterministic, no dependencies.
-struct Rng(u64);
+/// The harness's deterministic generator, with the f32 helpers these tests want.
+struct Rng(steradian_harness::rng::Rng);
 
 impl Rng {
     fn next_u64(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        z ^ (z >> 31)
+        self.0.next_u64()
     }
     /// Uniform in `[0, 1)`.
     fn unit(&mut self) -> f32 {
@@ -436,7 +432,7 @@ fn cap_inputs(rng: &mut Rng) -> Columns {
 }
 
 fn inputs(kernel: Kernel, seed: u64) -> Columns {
-    let mut rng = Rng(seed);
+    let mut rng = Rng(steradian_harness::rng::Rng::new(seed));
     match kernel {
         Kernel::HemisphereMap => map_inputs(&mut rng),
         Kernel::HemisphereUnmap => unmap_inputs(&mut rng),
@@ -498,7 +494,7 @@ fn large_batches_fold_into_2d_and_split_into_chunks() {
     let Some(mut gpu) = gpu() else { return };
     // 5M rows: more than 65535 workgroups of 64, so the dispatch is 2-D.
     let n = 5_000_000;
-    let mut rng = Rng(99);
+    let mut rng = Rng(steradian_harness::rng::Rng::new(99));
     let mut input = Columns::zeros(2, n);
     for r in 0..n {
         input.data[r] = rng.range(-1.0, 1000.0);

@@ -61,6 +61,17 @@ pub struct Machine {
     pub gpu_unavailable: Option<String>,
 }
 
+impl Machine {
+    /// The adapter, or why there is none.
+    pub fn gpu_description(&self) -> String {
+        match (&self.gpu_adapter, &self.gpu_unavailable) {
+            (Some(a), _) => a.clone(),
+            (None, Some(why)) => format!("none ({why})"),
+            (None, None) => "not tried".into(),
+        }
+    }
+}
+
 /// One kernel × backend measurement.
 #[derive(Clone, Debug, Serialize)]
 pub struct Row {
@@ -208,15 +219,7 @@ pub fn summary(r: &Report) -> String {
         r.machine.cpu,
         r.machine.cores,
         r.machine.simd,
-        r.machine
-            .gpu_adapter
-            .clone()
-            .or_else(|| r
-                .machine
-                .gpu_unavailable
-                .clone()
-                .map(|w| format!("none ({w})")))
-            .unwrap_or_else(|| "not tried".into())
+        r.machine.gpu_description()
     );
     s += &format!(
         "{:<17} {:<16} {:>11} {:>9} {:<19} {:>10} {:>10} {:>10} {:>9}\n",
@@ -306,11 +309,7 @@ documented on the kernel.</p>
         cpu = esc(&m.cpu),
         cores = m.cores,
         simd = esc(&m.simd),
-        gpu = esc(&m
-            .gpu_adapter
-            .clone()
-            .or_else(|| m.gpu_unavailable.clone().map(|w| format!("none ({w})")))
-            .unwrap_or_else(|| "not tried".into())),
+        gpu = esc(&m.gpu_description()),
         svg = svg::speed_vs_error(r),
     )
 }
