@@ -92,14 +92,11 @@ fn random_row(kernel: Kernel, r: &mut Rng) -> Vec<f32> {
             // Directions where the lobe matters: angle ~ a few widths 1/sqrt(e+1).
             let width = (1.0 / (e + 1.0)).sqrt();
             let theta = (r.unit() * 3.0 * width).min(std::f64::consts::PI);
-            let (u, w) = perpendiculars(a);
             let phi = r.range(0.0, std::f64::consts::TAU);
-            let dir: Vec<f64> = (0..3)
-                .map(|i| theta.cos() * a[i] + theta.sin() * (phi.cos() * u[i] + phi.sin() * w[i]))
-                .collect();
+            let dir = direction_at(a, theta, phi);
             let s = r.range(0.1, 10.0);
-            let an = unit32(&a);
-            let dn = unit32(&dir);
+            let an = unit32(a);
+            let dn = unit32(dir);
             vec![an[0], an[1], an[2], s as f32, e as f32, dn[0], dn[1], dn[2]]
         }
         Kernel::LobeIntegral => vec![r.log_range(1e-4, 1e5) as f32, r.range(-10.0, 10.0) as f32],
@@ -107,9 +104,18 @@ fn random_row(kernel: Kernel, r: &mut Rng) -> Vec<f32> {
     }
 }
 
-fn unit32(v: &[f64]) -> [f32; 3] {
+/// `v` normalised and rounded to f32.
+pub fn unit32(v: [f64; 3]) -> [f32; 3] {
     let l = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
     [(v[0] / l) as f32, (v[1] / l) as f32, (v[2] / l) as f32]
+}
+
+/// The direction at polar angle `theta` and azimuth `phi` around the unit axis `a`.
+pub fn direction_at(a: [f64; 3], theta: f64, phi: f64) -> [f64; 3] {
+    let (u, w) = perpendiculars(a);
+    std::array::from_fn(|i| {
+        theta.cos() * a[i] + theta.sin() * (phi.cos() * u[i] + phi.sin() * w[i])
+    })
 }
 
 fn perpendiculars(a: [f64; 3]) -> ([f64; 3], [f64; 3]) {

@@ -9,6 +9,7 @@ use steradian_core::cap::{self, CapFit, SphericalCap};
 use steradian_core::frame::Frame;
 use steradian_core::lobe::{self, CosineLobe, Lafortune, LafortuneLobe, Phong};
 use steradian_core::{Vec2, Vec3, hemisphere};
+use steradian_harness::workload::{self, unit32};
 use steradian_harness::{accuracy, reference};
 
 fn config() -> Config {
@@ -34,11 +35,6 @@ fn direction() -> impl Strategy<Value = [f32; 3]> {
             (z * k) as f32,
         ]
     })
-}
-
-fn unit(v: [f64; 3]) -> [f32; 3] {
-    let l = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
-    [(v[0] / l) as f32, (v[1] / l) as f32, (v[2] / l) as f32]
 }
 
 fn map_err(d: [f32; 3]) -> f64 {
@@ -102,14 +98,8 @@ proptest! {
     ) {
         let an = reference::normalize(a).unwrap();
         let theta = (width_mult / (e + 1.0).sqrt()).min(PI);
-        let t = if an[0].abs() < 0.9 { [1.0, 0.0, 0.0] } else { [0.0, 1.0, 0.0] };
-        let u = [an[1] * t[2] - an[2] * t[1], an[2] * t[0] - an[0] * t[2], an[0] * t[1] - an[1] * t[0]];
-        let ul = (u[0] * u[0] + u[1] * u[1] + u[2] * u[2]).sqrt();
-        let u = u.map(|c| c / ul);
-        let w = [an[1] * u[2] - an[2] * u[1], an[2] * u[0] - an[0] * u[2], an[0] * u[1] - an[1] * u[0]];
-        let v: Vec<f64> = (0..3).map(|i| theta.cos() * an[i] + theta.sin() * (phi.cos() * u[i] + phi.sin() * w[i])).collect();
-        let axis = unit(an);
-        let v = unit([v[0], v[1], v[2]]);
+        let axis = unit32(an);
+        let v = unit32(workload::direction_at(an, theta, phi));
         let err = lobe_err(axis, s as f32, e as f32, v);
         prop_assert!(err <= lobe::EVAL_REL_ERROR as f64, "axis {axis:?} e {e} v {v:?}: {err}");
     }
@@ -158,8 +148,8 @@ proptest! {
         let r = [k * n[0] - wo[0], k * n[1] - wo[1], k * n[2] - wo[2]];
         let want = kd as f64 * dot(n, v).max(0.0) + ks as f64 * dot(r, v).max(0.0).powf(e as f64);
         let p = Phong::new(kd, ks, e).unwrap();
-        let [dl, sl] = p.lobes(Vec3::from(unit(n)), Vec3::from(unit(wo)));
-        let vv = Vec3::from(unit(v));
+        let [dl, sl] = p.lobes(Vec3::from(unit32(n)), Vec3::from(unit32(wo)));
+        let vv = Vec3::from(unit32(v));
         let got = (dl.eval(vv) + sl.eval(vv)) as f64;
         // absolute in units of the BRDF's scale; the reflection is formed in f32.
         prop_assert!((got - want).abs() <= 1e-4 * (kd + ks) as f64 * (1.0 + e as f64).sqrt(), "{got} vs {want}");
@@ -214,7 +204,7 @@ fn hard_case_lobe_exponent_zero_and_1e5() {
         (1e5, 3e-3),
         (1e5, 1e-2),
     ] {
-        let v = unit([theta.sin(), 0.0, theta.cos()]);
+        let v = unit32([theta.sin(), 0.0, theta.cos()]);
         let err = lobe_err(z, 1.0, e, v);
         assert!(
             err <= lobe::EVAL_REL_ERROR as f64,
@@ -222,7 +212,7 @@ fn hard_case_lobe_exponent_zero_and_1e5() {
         );
     }
     // A plain powf(a·v, e) loses about e·2⁻²⁴ relative at 1e5; the kernel does not.
-    let v = unit([(3e-3f64).sin(), 0.0, (3e-3f64).cos()]);
+    let v = unit32([(3e-3f64).sin(), 0.0, (3e-3f64).cos()]);
     let naive = (Vec3::from(z).dot(Vec3::from(v))).powf(1e5) as f64;
     let want = reference::lobe_eval(z, 1.0, 1e5, v);
     let ours = lobe::eval(Vec3::from(z), 1.0, 1e5, Vec3::from(v)) as f64;

@@ -11,47 +11,11 @@ use steradian_simd::{LobeX8, Vec2x8, Vec3x8, cap, f32x8, hemisphere, lobe};
 // ---------------------------------------------------------------------------------------
 // Inputs
 
-/// SplitMix64: a tiny deterministic generator.
-struct Rng(u64);
+#[path = "common/rng.rs"]
+mod rng;
+use rng::Rng;
 
 impl Rng {
-    fn next_u64(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        z ^ (z >> 31)
-    }
-    /// Uniform in `[0, 1)`.
-    fn unit(&mut self) -> f32 {
-        (self.next_u64() >> 40) as f32 * (1.0 / (1u64 << 24) as f32)
-    }
-    /// Uniform in `[lo, hi)`.
-    fn range(&mut self, lo: f32, hi: f32) -> f32 {
-        lo + (hi - lo) * self.unit()
-    }
-    /// Log-uniform in `[lo, hi)`, `lo > 0`.
-    fn log_range(&mut self, lo: f32, hi: f32) -> f32 {
-        (lo.ln() + (hi.ln() - lo.ln()) * self.unit()).exp()
-    }
-    /// Any bit pattern.
-    fn bits(&mut self) -> f32 {
-        f32::from_bits(self.next_u64() as u32)
-    }
-    /// A random unit vector.
-    fn dir(&mut self) -> Vec3 {
-        loop {
-            let v = Vec3::new(
-                self.range(-1.0, 1.0),
-                self.range(-1.0, 1.0),
-                self.range(-1.0, 1.0),
-            );
-            let l = v.length();
-            if l > 1e-3 && l <= 1.0 {
-                return v / l;
-            }
-        }
-    }
     /// A component drawn from mixed magnitudes and signs (including specials now and then).
     fn mixed(&mut self) -> f32 {
         match self.next_u64() % 8 {
