@@ -153,7 +153,9 @@ impl SphericalCap {
 
     /// The cap subtended by the sphere `(centre, radius)` seen from `point`:
     /// `sin α = r/d`. The point must be strictly outside the sphere; every input finite and
-    /// the radius positive. Exact for huge and tiny coordinates (no overflow in `d`).
+    /// the radius positive. `α` and `1 − cos α` are within 2e-6 relative of f64 (tested for
+    /// distances up to 1e20); `d` is formed without overflow, so centres at 3e38 and 3e-38
+    /// give the right cap too.
     pub fn from_sphere(point: Vec3, centre: Vec3, radius: f32) -> Result<Self, Error> {
         if !point.is_finite() {
             return Err(Error::NonFinite { what: "point" });

@@ -1,7 +1,6 @@
 //! The one math shim: every float function the kernels use goes through here, so no other
 //! module needs a `cfg`. With the `std` feature the standard library is used, otherwise the
 //! `libm` crate.
-#![allow(dead_code)]
 
 #[cfg(feature = "std")]
 mod imp {
@@ -26,16 +25,8 @@ mod imp {
         x.sin()
     }
     #[inline(always)]
-    pub fn cosf(x: f32) -> f32 {
-        x.cos()
-    }
-    #[inline(always)]
     pub fn asinf(x: f32) -> f32 {
         x.asin()
-    }
-    #[inline(always)]
-    pub fn floorf(x: f32) -> f32 {
-        x.floor()
     }
     #[inline(always)]
     pub fn ceilf(x: f32) -> f32 {
@@ -66,16 +57,8 @@ mod imp {
         libm::sinf(x)
     }
     #[inline(always)]
-    pub fn cosf(x: f32) -> f32 {
-        libm::cosf(x)
-    }
-    #[inline(always)]
     pub fn asinf(x: f32) -> f32 {
         libm::asinf(x)
-    }
-    #[inline(always)]
-    pub fn floorf(x: f32) -> f32 {
-        libm::floorf(x)
     }
     #[inline(always)]
     pub fn ceilf(x: f32) -> f32 {
@@ -101,13 +84,7 @@ mod imp {
     pub fn sinf(x: f32) -> f32 {
         x
     }
-    pub fn cosf(x: f32) -> f32 {
-        x
-    }
     pub fn asinf(x: f32) -> f32 {
-        x
-    }
-    pub fn floorf(x: f32) -> f32 {
         x
     }
     pub fn ceilf(x: f32) -> f32 {

@@ -116,14 +116,6 @@ impl Columns {
         &mut self.data[c * self.n..(c + 1) * self.n]
     }
 
-    /// All columns as separate mutable slices.
-    pub fn cols_mut(&mut self) -> Vec<&mut [f32]> {
-        if self.n == 0 {
-            return (0..self.arity).map(|_| <&mut [f32]>::default()).collect();
-        }
-        self.data.chunks_exact_mut(self.n).collect()
-    }
-
     /// Row `i` as a vector.
     pub fn row(&self, i: usize) -> Vec<f32> {
         (0..self.arity).map(|c| self.data[c * self.n + i]).collect()
