@@ -2,6 +2,7 @@
 //! against the f64 references on the default workload, written as `report.json`,
 //! `index.html` (tables and SVG speed-against-error plots) and a summary on stdout.
 
+pub mod sections;
 mod svg;
 
 use std::path::PathBuf;
@@ -98,6 +99,8 @@ pub struct Report {
     pub machine: Machine,
     /// Every measurement.
     pub results: Vec<Row>,
+    /// Sections contributed by subsystems (lobe products, SAT/VDT, RSL shading, …), in order.
+    pub sections: Vec<sections::Section>,
 }
 
 impl Report {
@@ -197,12 +200,23 @@ pub fn run(opts: &Options) -> Result<Report, Box<dyn std::error::Error>> {
         }
     }
     bar.finish_and_clear();
-    let report = Report { machine, results };
+    drop(backends);
+    let sections = sections::run_all(opts)?;
+    let report = Report {
+        machine,
+        results,
+        sections,
+    };
     std::fs::create_dir_all(&opts.out)?;
     std::fs::write(
         opts.out.join("report.json"),
         serde_json::to_string_pretty(&report)?,
     )?;
+    for sec in &report.sections {
+        for (name, bytes) in &sec.files {
+            std::fs::write(opts.out.join(name), bytes)?;
+        }
+    }
     std::fs::write(opts.out.join("index.html"), html(&report))?;
     Ok(report)
 }
@@ -254,6 +268,9 @@ pub fn summary(r: &Report) -> String {
             );
         }
     }
+    for sec in &r.sections {
+        s += &format!("\n{}\n{}", sec.title, sec.summary);
+    }
     s
 }
 
@@ -304,6 +321,7 @@ documented on the kernel.</p>
 <h2>All measurements</h2>
 <table><tr><th>kernel</th><th>backend</th><th>Mevals/s</th><th>×scalar</th><th>metric</th><th>max</th><th>p99</th><th>mean</th><th>bound</th><th></th></tr>
 {rows}</table>
+{sections}
 </body></html>
 "#,
         cpu = esc(&m.cpu),
@@ -311,5 +329,15 @@ documented on the kernel.</p>
         simd = esc(&m.simd),
         gpu = esc(&m.gpu_description()),
         svg = svg::speed_vs_error(r),
+        sections = r
+            .sections
+            .iter()
+            .map(|sec| format!(
+                "<h2 id=\"{}\">{}</h2>\n{}\n",
+                sec.id,
+                esc(&sec.title),
+                sec.html
+            ))
+            .collect::<String>(),
     )
 }
