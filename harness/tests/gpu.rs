@@ -556,3 +556,45 @@ fn timing_1m() {
         );
     }
 }
+
+/// The generic path for kernels outside the `Kernel` enum: a caller-supplied table at
+/// binding 3, arities taken from the columns, chunking included.
+#[test]
+fn custom_kernel_with_a_caller_table() {
+    use steradian_harness::backend::gpu::Custom;
+    const SRC: &str = concat!(
+        include_str!("../../core/src/wgsl/batch.wgsl"),
+        "@group(0) @binding(3) var<storage, read> table: array<f32>;\n",
+        "@compute @workgroup_size(64) fn main(@builtin(global_invocation_id) gid: vec3<u32>) {\n",
+        "  let i = batch_row(gid); if (i >= params.n) { return; }\n",
+        "  let x = input[i]; let y = input[params.n + i];\n",
+        "  output[i] = x * y + table[u32(y)];\n",
+        "}\n"
+    );
+    let Some(mut g) = gpu() else { return };
+    let n = 1000;
+    let rows: Vec<[f32; 2]> = (0..n).map(|i| [i as f32 * 0.5, (i % 7) as f32]).collect();
+    let input = Columns::from_rows(&rows);
+    let table: Vec<f32> = (0..7).map(|k| 100.0 * k as f32).collect();
+    for chunk in [None, Some(33)] {
+        g.set_max_chunk_rows(chunk);
+        let mut out = Columns::zeros(1, n);
+        let custom = Custom {
+            label: "test-custom",
+            source: SRC,
+            table: Some(&table),
+        };
+        g.run_custom(&custom, &input, &mut out)
+            .expect("custom kernel runs");
+        for (i, r) in rows.iter().enumerate() {
+            assert_eq!(out.data[i], r[0] * r[1] + table[r[1] as usize], "row {i}");
+        }
+    }
+    let mut bad = Columns::zeros(1, n + 1);
+    let custom = Custom {
+        label: "test-custom",
+        source: SRC,
+        table: Some(&table),
+    };
+    assert!(g.run_custom(&custom, &input, &mut bad).is_err());
+}

@@ -94,9 +94,11 @@ pub struct Gpu {
     info: wgpu::AdapterInfo,
     layout: wgpu::BindGroupLayout,
     layout_table: wgpu::BindGroupLayout,
-    pipelines: HashMap<Kernel, wgpu::ComputePipeline>,
+    pipelines: HashMap<&'static str, wgpu::ComputePipeline>,
     params: wgpu::Buffer,
     table: wgpu::Buffer,
+    /// The caller's table of a [`Custom`] kernel.
+    user_table: Slot,
     input: Slot,
     output: Slot,
     staging: Slot,
@@ -287,6 +289,10 @@ impl Gpu {
                 "steradian output",
                 wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
             ),
+            user_table: Slot::new(
+                "steradian custom table",
+                wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
+            ),
             staging: Slot::new(
                 "steradian read-back",
                 wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
@@ -315,7 +321,11 @@ impl Gpu {
     /// Rows of one chunk for `kernel`: limited by the device's buffer limits, the dispatch
     /// grid and [`Gpu::set_max_chunk_rows`].
     pub fn chunk_rows(&self, kernel: Kernel) -> usize {
-        let arity = kernel.input_arity().max(kernel.output_arity()) as u64;
+        self.chunk_rows_for(kernel.input_arity(), kernel.output_arity())
+    }
+
+    fn chunk_rows_for(&self, input_arity: usize, output_arity: usize) -> usize {
+        let arity = input_arity.max(output_arity).max(1) as u64;
         let by_bytes = self.max_chunk_bytes / (4 * arity);
         let g = self.max_groups_per_dim as u64;
         let by_grid = g * g * WORKGROUP_SIZE as u64;
@@ -339,13 +349,13 @@ impl Gpu {
         }
     }
 
-    /// The pipeline of `kernel`, compiled on first use.
-    fn pipeline(&mut self, kernel: Kernel) -> Result<wgpu::ComputePipeline, BackendError> {
-        if let Some(p) = self.pipelines.get(&kernel) {
+    /// The pipeline of `job`, compiled on first use.
+    fn pipeline(&mut self, job: &Job) -> Result<wgpu::ComputePipeline, BackendError> {
+        if let Some(p) = self.pipelines.get(job.label) {
             return Ok(p.clone());
         }
-        let src = source(kernel)?;
-        let layout = if kernel == Kernel::CapExponent {
+        let (kernel, src) = (job.label, job.source);
+        let layout = if job.table.is_some() {
             &self.layout_table
         } else {
             &self.layout
@@ -353,16 +363,16 @@ impl Gpu {
         let device = &self.device;
         let pipeline = scoped(device, &format!("{kernel}: compiling"), || {
             let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
-                label: Some(kernel.name()),
+                label: Some(kernel),
                 source: wgpu::ShaderSource::Wgsl(src.into()),
             });
             let pl = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-                label: Some(kernel.name()),
+                label: Some(kernel),
                 bind_group_layouts: &[Some(layout)],
                 immediate_size: 0,
             });
             device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-                label: Some(kernel.name()),
+                label: Some(kernel),
                 layout: Some(&pl),
                 module: &module,
                 entry_point: Some("main"),
@@ -378,7 +388,7 @@ impl Gpu {
     /// Runs rows `r0..r0 + rows` of `input` into the same rows of `out`.
     fn run_chunk(
         &mut self,
-        kernel: Kernel,
+        job: &Job,
         pipeline: &wgpu::ComputePipeline,
         input: &Columns,
         out: &mut Columns,
@@ -386,7 +396,7 @@ impl Gpu {
         rows: usize,
     ) -> Result<(), BackendError> {
         let n = input.n;
-        let (ia, oa) = (kernel.input_arity(), kernel.output_arity());
+        let (kernel, ia, oa) = (job.label, job.input_arity, job.output_arity);
         let in_bytes = (ia * rows * 4) as u64;
         let out_bytes = (oa * rows * 4) as u64;
 
@@ -422,6 +432,7 @@ impl Gpu {
             }
         };
 
+        let user_table = self.user_table.buffer.clone();
         scoped(&device, &format!("{kernel}: dispatch"), || {
             // Column c of the chunk goes to c·rows in the input buffer (column-major).
             if r0 == 0 && rows == n {
@@ -448,27 +459,38 @@ impl Gpu {
                     resource: self.params.as_entire_binding(),
                 },
             ];
-            let layout = if kernel == Kernel::CapExponent {
-                entries.push(wgpu::BindGroupEntry {
-                    binding: 3,
-                    resource: self.table.as_entire_binding(),
-                });
-                &self.layout_table
-            } else {
-                &self.layout
+            let layout = match job.table {
+                None => &self.layout,
+                Some(TableSource::CapExponent) => {
+                    entries.push(wgpu::BindGroupEntry {
+                        binding: 3,
+                        resource: self.table.as_entire_binding(),
+                    });
+                    &self.layout_table
+                }
+                Some(TableSource::User(bytes)) => {
+                    entries.push(wgpu::BindGroupEntry {
+                        binding: 3,
+                        resource: binding(
+                            user_table.as_ref().expect("uploaded before the dispatch"),
+                            bytes,
+                        ),
+                    });
+                    &self.layout_table
+                }
             };
             let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-                label: Some(kernel.name()),
+                label: Some(kernel),
                 layout,
                 entries: &entries,
             });
 
             let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
-                label: Some(kernel.name()),
+                label: Some(kernel),
             });
             {
                 let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
-                    label: Some(kernel.name()),
+                    label: Some(kernel),
                     timestamp_writes: None,
                 });
                 pass.set_pipeline(pipeline);
@@ -516,6 +538,101 @@ impl Gpu {
     }
 }
 
+/// Where binding 3 of a job comes from.
+#[derive(Clone, Copy, Debug)]
+enum TableSource {
+    /// The built-in cap-exponent table.
+    CapExponent,
+    /// The caller's table, this many bytes (already uploaded to `user_table`).
+    User(u64),
+}
+
+/// One compute job: a complete WGSL source with the batch bindings.
+struct Job {
+    label: &'static str,
+    source: &'static str,
+    input_arity: usize,
+    output_arity: usize,
+    table: Option<TableSource>,
+}
+
+/// A WGSL kernel outside [`Kernel`] (lobe products, SAT and VDT queries, RSL shading, …) with
+/// the batch bindings of [`steradian_core::wgsl`]: 0 = input columns, 1 = output columns,
+/// 2 = `Params`, and 3 = `table`, a read-only `array<f32>` the caller supplies (or none).
+#[derive(Clone, Copy, Debug)]
+pub struct Custom<'a> {
+    /// Pipeline cache key and label; one label per source.
+    pub label: &'static str,
+    /// The complete WGSL source (prelude included).
+    pub source: &'static str,
+    /// Binding 3, or `None` for a kernel without it. Uploaded on every call.
+    pub table: Option<&'a [f32]>,
+}
+
+impl Gpu {
+    /// Runs a [`Custom`] kernel: `input.arity` columns in, `out.arity` columns out, `out.n`
+    /// must equal `input.n`. Batches are split into chunks as for the built-in kernels.
+    pub fn run_custom(
+        &mut self,
+        custom: &Custom<'_>,
+        input: &Columns,
+        out: &mut Columns,
+    ) -> Result<(), BackendError> {
+        if out.n != input.n
+            || input.data.len() != input.arity * input.n
+            || out.data.len() != out.arity * out.n
+        {
+            return Err(BackendError(format!(
+                "{}: column shapes do not match ({}×{} in, {}×{} out)",
+                custom.label, input.arity, input.n, out.arity, out.n
+            )));
+        }
+        let table = match custom.table {
+            None => None,
+            Some(t) => {
+                // An empty storage binding is invalid: bind one zero instead.
+                let data: &[f32] = if t.is_empty() { &[0.0] } else { t };
+                let bytes = (data.len() * 4) as u64;
+                let device = self.device.clone();
+                let buf = scoped(&device, &format!("{}: table", custom.label), || {
+                    self.user_table.get(&device, bytes).clone()
+                })?;
+                self.queue.write_buffer(&buf, 0, bytemuck::cast_slice(data));
+                Some(TableSource::User(bytes))
+            }
+        };
+        let job = Job {
+            label: custom.label,
+            source: custom.source,
+            input_arity: input.arity,
+            output_arity: out.arity,
+            table,
+        };
+        self.run_job(&job, input, out)
+    }
+
+    fn run_job(
+        &mut self,
+        job: &Job,
+        input: &Columns,
+        out: &mut Columns,
+    ) -> Result<(), BackendError> {
+        let n = input.n;
+        if n == 0 {
+            return Ok(());
+        }
+        let pipeline = self.pipeline(job)?;
+        let chunk = self.chunk_rows_for(job.input_arity, job.output_arity);
+        let mut r0 = 0;
+        while r0 < n {
+            let rows = chunk.min(n - r0);
+            self.run_chunk(job, &pipeline, input, out, r0, rows)?;
+            r0 += rows;
+        }
+        Ok(())
+    }
+}
+
 impl Backend for Gpu {
     fn name(&self) -> &'static str {
         "wgpu"
@@ -528,18 +645,13 @@ impl Backend for Gpu {
         out: &mut Columns,
     ) -> Result<(), BackendError> {
         check_shapes(kernel, input, out)?;
-        let n = input.n;
-        if n == 0 {
-            return Ok(());
-        }
-        let pipeline = self.pipeline(kernel)?;
-        let chunk = self.chunk_rows(kernel);
-        let mut r0 = 0;
-        while r0 < n {
-            let rows = chunk.min(n - r0);
-            self.run_chunk(kernel, &pipeline, input, out, r0, rows)?;
-            r0 += rows;
-        }
-        Ok(())
+        let job = Job {
+            label: kernel.name(),
+            source: source(kernel)?,
+            input_arity: kernel.input_arity(),
+            output_arity: kernel.output_arity(),
+            table: (kernel == Kernel::CapExponent).then_some(TableSource::CapExponent),
+        };
+        self.run_job(&job, input, out)
     }
 }
