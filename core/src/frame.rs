@@ -61,7 +61,7 @@ impl Frame {
         })
     }
 
-    fn from_unit_normal(n: Vec3) -> Frame {
+    pub(crate) fn from_unit_normal(n: Vec3) -> Frame {
         let sign = if n.z >= 0.0 { 1.0 } else { -1.0 };
         let a = -1.0 / (sign + n.z);
         let b = n.x * n.y * a;

@@ -63,6 +63,7 @@ pub mod cap;
 pub mod frame;
 pub mod hemisphere;
 pub mod lobe;
+pub mod product;
 pub mod table;
 pub mod wgsl;
 
