@@ -4,6 +4,7 @@
 //! regenerates in memory and fails if a committed file differs.
 
 pub mod cap_exponent;
+pub mod lobe_product;
 
 use std::path::{Path, PathBuf};
 
@@ -18,11 +19,18 @@ pub struct TableDef {
 }
 
 /// Every built-in table.
-pub const TABLES: &[TableDef] = &[TableDef {
-    file: "cap_exponent.bin",
-    about: "h(α) = e*(α)·α², L2-optimal cap exponent, uniform over [0, π/2]",
-    generate: cap_exponent::generate,
-}];
+pub const TABLES: &[TableDef] = &[
+    TableDef {
+        file: "cap_exponent.bin",
+        about: "h(α) = e*(α)·α², L2-optimal cap exponent, uniform over [0, π/2]",
+        generate: cap_exponent::generate,
+    },
+    TableDef {
+        file: "lobe_product.bin",
+        about: "g = ln I − ln B, the lobe-product integral's correction to its closed-form baseline",
+        generate: lobe_product::generate,
+    },
+];
 
 /// `core/src/tables` of this source tree.
 pub fn default_dir() -> PathBuf {
