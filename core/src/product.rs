@@ -263,6 +263,9 @@ pub struct Baseline {
     pub peak_dir: (f32, f32),
     /// `ln` of the product's peak value `cos^e1(t*)·cos^e2(α − t*)`.
     pub ln_peak: f32,
+    /// Curvature of `−ln(product)` at the peak along the arc,
+    /// `e1·sec²t* + e2·sec²(α − t*)` (across the arc it is `e1 + e2`).
+    pub arc_curvature: f32,
 }
 
 /// The closed-form part of the product of unit lobes with exponents `e1, e2` (clamped to
@@ -278,10 +281,11 @@ pub fn baseline(e1: f32, e2: f32, cos_a: f32, sin_a: f32) -> Baseline {
             w: f32::NAN,
             peak_dir: (f32::NAN, f32::NAN),
             ln_peak: f32::NAN,
+            arc_curvature: f32::NAN,
         };
     }
     // The peak of the product itself (exponents e1, e2): direction and value.
-    let (peak_dir, ln_peak) = if e1 + e2 > 0.0 && (e1 + e2).is_finite() {
+    let (peak_dir, ln_peak, arc_curvature) = if e1 + e2 > 0.0 && (e1 + e2).is_finite() {
         let (r, omr2) = ratio(e1, e2);
         let cy = math::sqrtf(c * c + omr2 * s * s);
         let (sn1, cs1) = peak_pair(s, c, r, omr2, cy);
@@ -295,14 +299,21 @@ pub fn baseline(e1: f32, e2: f32, cos_a: f32, sin_a: f32) -> Baseline {
                 e * ln_cos_half(omc, opc)
             }
         };
+        // sec²t = 2/(1 + cos 2t).
+        let curv = |e: f32, opc: f32| if e == 0.0 { 0.0 } else { e * 2.0 / opc };
         (
             (math::sqrtf(0.5 * opc1), math::sqrtf(0.5 * omc1)),
             term(e1, omc1, opc1) + term(e2, omc2, opc2),
+            curv(e1, opc1) + curv(e2, opc2),
         )
     } else {
         // Both exponents 0 (a lune: constant on it) or infinite: the bisector.
         let (omc, opc) = one_pm_cos(s, c);
-        ((math::sqrtf(0.5 * opc), math::sqrtf(0.5 * omc)), 0.0)
+        (
+            (math::sqrtf(0.5 * opc), math::sqrtf(0.5 * omc)),
+            0.0,
+            e1 + e2,
+        )
     };
 
     // Laplace in the logit variable around the peak of sin^(e1+1)·sin^(e2+1) on the lune.
@@ -322,6 +333,7 @@ pub fn baseline(e1: f32, e2: f32, cos_a: f32, sin_a: f32) -> Baseline {
             w: 1.0,
             peak_dir,
             ln_peak,
+            arc_curvature,
         };
     }
     let (omcx, opcx) = one_pm_cos(snx, csx);
@@ -352,6 +364,7 @@ pub fn baseline(e1: f32, e2: f32, cos_a: f32, sin_a: f32) -> Baseline {
         w,
         peak_dir,
         ln_peak,
+        arc_curvature,
     }
 }
 
@@ -388,9 +401,15 @@ fn arc_frame(a1: Vec3, a2: Vec3) -> (f32, f32, Vec3) {
 /// Which exponent the result lobe gets. The scale is the product's peak value in both.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
 pub enum ProductFit {
-    /// `2π·p/(e_r + 1) = I` from the table: the result integrates exactly (default).
+    /// `2π·p/(e_r + 1) = I` from the table, `p` the product's peak value: the result
+    /// integrates exactly and equals the product at its peak (default).
     #[default]
     ExactIntegral,
+    /// `I` from the table, exponent from the product's curvature at its peak,
+    /// `e_r = √((e1 + e2)·(e1·sec²t* + e2·sec²(α − t*)))` (the geometric mean of its
+    /// curvatures across and along the arc), scale `p = I·(e_r + 1)/(2π)`: integrates
+    /// exactly and matches the width of the peak instead of its height.
+    ExactIntegralCurvature,
     /// `I` from the spherical-Gaussian closed form (no table): `λ = e` for each lobe,
     /// `∫ = 2π(1 − e^(−2λ_r))/λ_r·e^(λ_r − λ1 − λ2)`. Off by `1/(2e)` at `α = 0`, by 50 %
     /// when a sharp lobe meets a hemisphere at the horizon, by orders of magnitude at wide
@@ -442,7 +461,7 @@ pub fn product_with(
     let (c, s, w) = arc_frame(a.axis(), b.axis());
     let base = baseline(e1, e2, c, s);
     let ln_i = match fit {
-        ProductFit::ExactIntegral => {
+        ProductFit::ExactIntegral | ProductFit::ExactIntegralCurvature => {
             base.ln_b + table.correction(exponent_coord(e1), exponent_coord(e2), base.w)
         }
         ProductFit::SphericalGaussian => ln_sg_integral(e1, e2, c, s),
@@ -452,6 +471,12 @@ pub fn product_with(
     let scale = a.scale() * b.scale();
     if ln_i == f32::NEG_INFINITY {
         return CosineLobe::saturating(axis, 0.0 * scale, 0.0);
+    }
+    if fit == ProductFit::ExactIntegralCurvature {
+        let e_r = math::sqrtf((e1.max(0.0) + e2.max(0.0)) * base.arc_curvature);
+        // p·2π/(e_r + 1) = I.
+        let p = math::expf(ln_i) * (e_r + 1.0) * (1.0 / TWO_PI);
+        return CosineLobe::saturating(axis, scale * p, e_r);
     }
     // 2π·peak/(e_r + 1) = I.
     let e_r = math::expf(math::logf(TWO_PI) + base.ln_peak - ln_i) - 1.0;

@@ -113,6 +113,14 @@ fn integral_error_over_the_whole_domain_on_unseen_inputs() {
         s.worst
     );
 
+    // The curvature-matched fit takes the same integral.
+    let c = stats(&points, ProductFit::ExactIntegralCurvature);
+    assert!(
+        c.max <= INTEGRAL_REL_MAX && c.p99 <= INTEGRAL_REL_P99,
+        "curvature fit {:.2e}",
+        c.max
+    );
+
     // The closed form the table corrects is far worse on the same points.
     let sg = stats(&points, ProductFit::SphericalGaussian);
     println!(
