@@ -31,6 +31,10 @@ pub const KERNELS: &[(&str, &str)] = &[
         r#"{"dir": [x,y,z] with z ≥ 0, any non-zero length} -> {"p": [u,v]}"#,
     ),
     (
+        "lobe-product",
+        r#"{"e1": e1, "e2": e2, "alpha": α} -> {"scale": p, "exponent": e_r, "axis_angle": β, "integral": 2πp/(e_r+1)} (unit lobes, a1 = +z, a2 toward +x)"#,
+    ),
+    (
         "hemisphere-unmap",
         r#"{"p": [u,v] with u²+v² ≤ 1} -> {"dir": [x,y,z]}"#,
     ),
@@ -109,6 +113,7 @@ pub fn eval_line(kernel: &str, line: &str) -> Result<Value, String> {
         .as_object()
         .ok_or_else(|| "each line must be a JSON object".to_string())?;
     match kernel {
+        "lobe-product" => crate::product::eval_lobe_product(obj),
         "lobe-integral" => {
             let (e, s) = (exponent(obj)?, scale(obj)?);
             Ok(json!({ "integral": num(lobe::integral(e, s)) }))

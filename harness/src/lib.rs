@@ -8,6 +8,7 @@ pub mod accuracy;
 pub mod backend;
 pub mod eval;
 pub mod generate;
+pub mod product;
 pub mod kernels;
 pub mod reference;
 pub mod report;

@@ -357,3 +357,25 @@ fn bad_inputs_saturate() {
     assert!(product::product(&z, &nan).scale().is_nan());
     assert_eq!(TWO_PI, std::f32::consts::TAU);
 }
+
+/// The report's lobe-product section runs and shows the built-in table within contract,
+/// the smaller tables worse, the closed form worst.
+#[test]
+fn report_section_orders_tables_by_error() {
+    let s = steradian_harness::report::product::section(&Default::default()).expect("section runs");
+    println!("{}", s.summary);
+    let rows = s.data["tables"].as_array().expect("rows");
+    let mean = |i: usize| rows[i]["mean"].as_f64().unwrap();
+    let n = rows.len();
+    assert!(
+        mean(n - 2) <= INTEGRAL_REL_MEAN,
+        "built-in mean {}",
+        mean(n - 2)
+    );
+    assert!(mean(0) > mean(n - 2) && mean(n - 1) > mean(0));
+    assert!(
+        s.files
+            .iter()
+            .any(|(f, b)| f.ends_with(".svg") && b.starts_with(b"<svg"))
+    );
+}

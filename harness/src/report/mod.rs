@@ -2,6 +2,8 @@
 //! against the f64 references on the default workload, written as `report.json`,
 //! `index.html` (tables and SVG speed-against-error plots) and a summary on stdout.
 
+pub mod plot;
+pub mod product;
 pub mod sections;
 mod svg;
 

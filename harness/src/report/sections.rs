@@ -30,7 +30,7 @@ pub struct Section {
 pub type Producer = fn(&Options) -> Result<Section, Box<dyn std::error::Error>>;
 
 /// Every section, in report order.
-pub const PRODUCERS: &[Producer] = &[];
+pub const PRODUCERS: &[Producer] = &[super::product::section];
 
 /// Runs every section producer.
 pub fn run_all(opts: &Options) -> Result<Vec<Section>, Box<dyn std::error::Error>> {
