@@ -1,0 +1,425 @@
+//! Report section "lobe-sum": the rendering integral `∫ R·L·V` as a chain of lobe products
+//! (`steradian_core::lobe_sum::triple`) on a Figure-16-like scene of the cosine-lobe paper —
+//! shaded points on a plane, one spherical light, a cluster of sphere occluders, a glossy
+//! Phong material — for a range of pruning thresholds `t` (section 4.3): error against f64
+//! quadrature together with the number of products computed and the time per point, i.e.
+//! a speed-against-error curve, for each product fit the kernel offers and both places of
+//! the cosine term.
+//!
+//! Error metric: `|chain − reference|` over the brightest unshadowed value of the scene
+//! (image units), against the *lobe-model* reference (`reference::triple`, the same light
+//! and occluder lobes, exact cosine), which isolates the chain's own error. The error of the
+//! lobe model itself against the *physical* reference (cap indicator light, exact
+//! occluders) is given beside it. The time ratio baseline is the same curve at `t = 0`
+//! (every product computed) in the same run.
+
+use std::error::Error;
+use std::time::Instant;
+
+use indicatif::{ProgressBar, ProgressStyle};
+use serde_json::json;
+use steradian_core::Vec3;
+use steradian_core::cap::{CapFit, SphericalCap};
+use steradian_core::lobe::{CosineLobe, Phong};
+use steradian_core::lobe_sum::{
+    Cosine, LobeSum, ProductCounts, light_with_cosine, phong_reflectance, triple_with,
+};
+use steradian_core::product::{self, ProductFit, ProductTable};
+
+use super::Options;
+use super::sections::Section;
+use crate::reference::triple::{self as reference, Cap, Lobe, Scene, Term, Visibility};
+use crate::rng::Rng;
+
+/// Pruning thresholds, in units of the brightest unshadowed value of the scene.
+const THRESHOLDS: [f64; 10] = [0.0, 1e-6, 1e-5, 1e-4, 3e-4, 1e-3, 3e-3, 1e-2, 3e-2, 0.1];
+/// Shaded points (a grid on the plane) and occluders.
+const GRID: (usize, usize) = (8, 5);
+const OCCLUDERS: usize = 32;
+/// Quadrature tolerance of the references.
+const REF_TOL: f64 = 1e-6;
+
+struct Point {
+    r: [LobeSum<2>; 2],
+    l: [LobeSum<1>; 2],
+    v: LobeSum<OCCLUDERS>,
+    lobe_ref: f64,
+    phys_ref: f64,
+    unshadowed: f64,
+    half_angle: f32,
+}
+
+/// One curve: a product fit and a place for the cosine.
+struct Curve {
+    name: &'static str,
+    fit: ProductFit,
+    cosine: Cosine,
+    color: &'static str,
+}
+
+const CURVES: [Curve; 4] = [
+    Curve {
+        name: "exact integral, cos on light",
+        fit: ProductFit::ExactIntegral,
+        cosine: Cosine::WithLight,
+        color: "#1f77b4",
+    },
+    Curve {
+        name: "exact integral + curvature, cos on light",
+        fit: ProductFit::ExactIntegralCurvature,
+        cosine: Cosine::WithLight,
+        color: "#2ca02c",
+    },
+    Curve {
+        name: "SG closed form, cos on light",
+        fit: ProductFit::SphericalGaussian,
+        cosine: Cosine::WithLight,
+        color: "#d62728",
+    },
+    Curve {
+        name: "exact integral, cos on BRDF",
+        fit: ProductFit::ExactIntegral,
+        cosine: Cosine::WithBrdf,
+        color: "#ff7f0e",
+    },
+];
+
+fn v3(v: Vec3) -> [f64; 3] {
+    [v.x as f64, v.y as f64, v.z as f64]
+}
+
+fn order_index(c: Cosine) -> usize {
+    usize::from(c == Cosine::WithBrdf)
+}
+
+/// The scene: points on the plane z = 0, light above, occluders in between.
+fn build_points(bar: &ProgressBar) -> Result<Vec<Point>, Box<dyn Error>> {
+    let mut rng = Rng::new(0x1f16_0b5e);
+    let light_c = Vec3::new(0.6, 0.2, 3.0);
+    let light_r = 0.35f32;
+    let eye = Vec3::new(-0.4, -3.0, 2.2);
+    let phong = Phong::modified(0.3, 0.6, 150.0)?;
+    // A cluster of spheres ("the bunny") between the light and the plane.
+    let blob = Vec3::new(0.35, 0.1, 1.3);
+    let mut spheres: Vec<(Vec3, f32)> = Vec::new();
+    while spheres.len() < OCCLUDERS {
+        let d = Vec3::from(rng.sphere().map(|x| x as f32)) * (rng.unit().cbrt() as f32 * 0.4);
+        let r = rng.range(0.04, 0.1) as f32;
+        let c = blob + d;
+        if spheres.iter().all(|(o, ro)| (*o - c).length() > *ro + r) {
+            spheres.push((c, r));
+        }
+    }
+    let n = Vec3::Z;
+    let mut points = Vec::new();
+    for j in 0..GRID.1 {
+        for i in 0..GRID.0 {
+            let x = Vec3::new(
+                -0.6 + 1.6 * i as f32 / (GRID.0 - 1) as f32,
+                -0.8 + 1.6 * j as f32 / (GRID.1 - 1) as f32,
+                0.0,
+            );
+            let wo = (eye - x).normalize();
+            let cap = SphericalCap::from_sphere(x, light_c, light_r)?;
+            let caps: Vec<SphericalCap> = spheres
+                .iter()
+                .map(|(c, r)| SphericalCap::from_sphere(x, *c, *r))
+                .collect::<Result<_, _>>()?;
+            let mut c = ProductCounts::default();
+            let mut raw = LobeSum::<1>::new();
+            raw.push_cap(&cap, 1.0, CapFit::L2);
+            let mut v = LobeSum::<OCCLUDERS>::unoccluded();
+            for oc in &caps {
+                v.push_occluder(oc, 1.0, CapFit::L2);
+            }
+            let r = [Cosine::WithLight, Cosine::WithBrdf]
+                .map(|o| phong_reflectance(&phong, n, wo, o, &mut c));
+            let l = [Cosine::WithLight, Cosine::WithBrdf]
+                .map(|o| light_with_cosine(&raw, n, o, &mut c));
+            // Exact reflectance: Phong's diffuse lobe (f_d·cos) and the specular lobe times
+            // the exact cosine.
+            let [d, s] = phong.lobes(n, wo);
+            let refl = vec![
+                Term::Lobe(Lobe::from_core(&d)),
+                Term::LobeTimesCosine(Lobe::from_core(&s), v3(n)),
+            ];
+            let lobe_ref = reference::triple(
+                &Scene {
+                    reflectance: refl.clone(),
+                    light: reference::terms_of(&raw),
+                    visibility: Visibility::Lobes(reference::terms_of(&v)),
+                },
+                REF_TOL,
+            );
+            let phys_ref = reference::triple(
+                &Scene {
+                    reflectance: refl,
+                    light: vec![Term::Cap(Cap::from_core(&cap), 1.0)],
+                    visibility: Visibility::Occluders(caps.iter().map(Cap::from_core).collect()),
+                },
+                REF_TOL,
+            );
+            points.push(Point {
+                r,
+                l,
+                v,
+                lobe_ref: lobe_ref.value,
+                phys_ref: phys_ref.value,
+                unshadowed: lobe_ref.scale,
+                half_angle: cap.half_angle(),
+            });
+            bar.inc(1);
+        }
+    }
+    Ok(points)
+}
+
+struct Row {
+    curve: usize,
+    t: f64,
+    products: f64,
+    dropped: f64,
+    ns_per_point: f64,
+    err_max: f64,
+    err_mean: f64,
+}
+
+fn kernel(fit: ProductFit) -> impl Fn(&CosineLobe, &CosineLobe) -> CosineLobe {
+    move |a, b| product::product_with(&ProductTable::builtin(), fit, a, b)
+}
+
+fn run_curve(points: &[Point], ci: usize, t: f32) -> (Vec<f32>, ProductCounts) {
+    let c = &CURVES[ci];
+    let k = kernel(c.fit);
+    let o = order_index(c.cosine);
+    let mut counts = ProductCounts::default();
+    let vals = points
+        .iter()
+        .map(|p| triple_with(&k, &p.r[o], &p.l[o], &p.v, t, &mut counts))
+        .collect();
+    (vals, counts)
+}
+
+/// The report section (see the module docs).
+pub fn section(_opts: &Options) -> Result<Section, Box<dyn Error>> {
+    let n_points = (GRID.0 * GRID.1) as u64;
+    let bar = ProgressBar::new(n_points + (CURVES.len() * THRESHOLDS.len()) as u64).with_style(
+        ProgressStyle::with_template("{spinner} [{elapsed_precise}] {bar:30} {pos}/{len} {msg}")
+            .unwrap_or_else(|_| ProgressStyle::default_bar()),
+    );
+    bar.set_message("lobe-sum: f64 references");
+    let t0 = Instant::now();
+    let points = build_points(&bar)?;
+    let ref_s = t0.elapsed().as_secs_f64();
+    let scale = points.iter().map(|p| p.unshadowed).fold(0.0, f64::max);
+    bar.set_message("lobe-sum: chains");
+    let mut rows = Vec::new();
+    let mut model_err = (0.0f64, 0.0f64);
+    for (ci, _) in CURVES.iter().enumerate() {
+        for &k in &THRESHOLDS {
+            let t = (k * scale) as f32;
+            let (vals, counts) = run_curve(&points, ci, t);
+            let errs: Vec<f64> = vals
+                .iter()
+                .zip(&points)
+                .map(|(v, p)| (*v as f64 - p.lobe_ref).abs() / scale)
+                .collect();
+            if ci == 0 && k == 0.0 {
+                for (v, p) in vals.iter().zip(&points) {
+                    let e = (*v as f64 - p.phys_ref).abs() / scale;
+                    model_err.0 = model_err.0.max(e);
+                    model_err.1 += e / points.len() as f64;
+                }
+            }
+            // Time: median of 5 runs over every point.
+            let mut times: Vec<f64> = (0..5)
+                .map(|_| {
+                    let s = Instant::now();
+                    let (v, _) = run_curve(&points, ci, t);
+                    std::hint::black_box(v);
+                    s.elapsed().as_secs_f64()
+                })
+                .collect();
+            times.sort_by(f64::total_cmp);
+            rows.push(Row {
+                curve: ci,
+                t: k,
+                products: counts.computed as f64 / points.len() as f64,
+                dropped: counts.dropped() as f64 / points.len() as f64,
+                ns_per_point: times[2] * 1e9 / points.len() as f64,
+                err_max: errs.iter().copied().fold(0.0, f64::max),
+                err_mean: errs.iter().sum::<f64>() / errs.len() as f64,
+            });
+            bar.inc(1);
+        }
+    }
+    bar.finish_and_clear();
+
+    let base = |ci: usize| {
+        rows.iter()
+            .find(|r| r.curve == ci && r.t == 0.0)
+            .map_or(1.0, |r| r.ns_per_point)
+    };
+    let mut table = String::from(
+        "<table><tr><th>kernel fit, cosine</th><th>t / max S</th><th>products / point</th><th>dropped / point</th><th>ns / point</th><th>speed ×(t = 0)</th><th>max error / max S</th><th>mean error / max S</th></tr>\n",
+    );
+    let mut summary = format!(
+        "  {} points, 1 light, {OCCLUDERS} occluders; references {ref_s:.1} s; error vs lobe-model quadrature / brightest unshadowed value\n",
+        points.len()
+    );
+    summary += &format!(
+        "  {:<42} {:>8} {:>9} {:>9} {:>7} {:>10} {:>10}\n",
+        "fit, cosine", "t/maxS", "products", "ns/point", "×(t=0)", "max err", "mean err"
+    );
+    for r in &rows {
+        let c = &CURVES[r.curve];
+        let speed = base(r.curve) / r.ns_per_point;
+        table += &format!(
+            "<tr><td>{}</td><td>{:.0e}</td><td>{:.1}</td><td>{:.1}</td><td>{:.0}</td><td>{:.2}</td><td>{:.2e}</td><td>{:.2e}</td></tr>\n",
+            c.name, r.t, r.products, r.dropped, r.ns_per_point, speed, r.err_max, r.err_mean
+        );
+        summary += &format!(
+            "  {:<42} {:>8.0e} {:>9.1} {:>9.0} {:>7.2} {:>10.2e} {:>10.2e}\n",
+            c.name, r.t, r.products, r.ns_per_point, speed, r.err_max, r.err_mean
+        );
+    }
+    table += "</table>\n";
+    summary += &format!(
+        "  lobe model vs physical (cap light, exact occluders), t = 0: max {:.2e}, mean {:.2e} of max S\n",
+        model_err.0, model_err.1
+    );
+    let svg = plot(&rows);
+    let html = format!(
+        "<p>Figure 16 of the cosine-lobe paper as a curve: {} shaded points on a plane under one \
+         spherical light (cap half-angles {:.3}–{:.3} rad) and {OCCLUDERS} sphere occluders, modified \
+         Phong (k<sub>d</sub> 0.3, k<sub>s</sub> 0.6, e = 150). For each pruning threshold t (in units of the \
+         brightest unshadowed value, max S = {scale:.4e}) the chain <code>lobe_sum::triple</code> runs over every \
+         point: products computed per point against the error against f64 quadrature of the same lobe \
+         model (light and occluders as the chain's cap lobes, exact cosine). The speed ratio is to the \
+         same curve at t = 0 in this run. The lobe model itself differs from the physical integral (cap \
+         indicator light, exact occluders) by max {:.2e}, mean {:.2e} of max S: that is the caps-as-lobes \
+         representation, which no product kernel removes.</p>\n<p><img src=\"lobe_sum.svg\" alt=\"error against products\"></p>\n{table}",
+        points.len(),
+        points
+            .iter()
+            .map(|p| p.half_angle)
+            .fold(f32::INFINITY, f32::min),
+        points.iter().map(|p| p.half_angle).fold(0.0, f32::max),
+        model_err.0,
+        model_err.1,
+    );
+    let data = json!({
+        "points": points.len(),
+        "occluders": OCCLUDERS,
+        "max_unshadowed": scale,
+        "reference_seconds": ref_s,
+        "model_error_max": model_err.0,
+        "model_error_mean": model_err.1,
+        "rows": rows.iter().map(|r| json!({
+            "fit": CURVES[r.curve].name,
+            "threshold": r.t,
+            "products_per_point": r.products,
+            "dropped_per_point": r.dropped,
+            "ns_per_point": r.ns_per_point,
+            "speed_vs_t0": base(r.curve) / r.ns_per_point,
+            "error_max": r.err_max,
+            "error_mean": r.err_mean,
+        })).collect::<Vec<_>>(),
+    });
+    Ok(Section {
+        id: "lobe-sum",
+        title: "Lobe sums: ∫ f_r·L·V, error against products (pruning threshold)".into(),
+        summary,
+        html,
+        data,
+        files: vec![("lobe_sum.svg".into(), svg.into_bytes())],
+    })
+}
+
+/// Max error (log y) against products per point (x), one polyline per curve.
+fn plot(rows: &[Row]) -> String {
+    const FLOOR: f64 = 1e-8;
+    let (w, h, l, t, pw, ph) = (720.0, 420.0, 70.0, 20.0, 600.0, 330.0);
+    let xmax = rows.iter().map(|r| r.products).fold(1.0, f64::max).ceil();
+    let ys: Vec<f64> = rows.iter().map(|r| r.err_max.max(FLOOR).log10()).collect();
+    let y0 = ys.iter().copied().fold(f64::INFINITY, f64::min).floor();
+    let y1 = ys
+        .iter()
+        .copied()
+        .fold(f64::NEG_INFINITY, f64::max)
+        .ceil()
+        .max(y0 + 1.0);
+    let px = |x: f64| l + x / xmax * pw;
+    let py = |y: f64| t + (y1 - y) / (y1 - y0) * ph;
+    let mut s = format!(
+        r##"<svg xmlns="http://www.w3.org/2000/svg" width="{w}" height="{h}" viewBox="0 0 {w} {h}" font-family="sans-serif" font-size="11">
+<rect width="100%" height="100%" fill="white"/>
+<rect x="{l}" y="{t}" width="{pw}" height="{ph}" fill="none" stroke="#999"/>
+<text x="{}" y="{}" text-anchor="middle" fill="#555">products computed per point</text>
+<text transform="translate(14,{}) rotate(-90)" text-anchor="middle" fill="#555">max error / brightest value</text>
+"##,
+        l + pw / 2.0,
+        t + ph + 30.0,
+        t + ph / 2.0
+    );
+    let mut y = y0;
+    while y <= y1 + 1e-9 {
+        s += &format!(
+            r##"<text x="{}" y="{}" text-anchor="end" fill="#555">1e{}</text><line x1="{l}" x2="{}" y1="{}" y2="{}" stroke="#eee"/>
+"##,
+            l - 4.0,
+            py(y) + 4.0,
+            y as i32,
+            l + pw,
+            py(y),
+            py(y)
+        );
+        y += 1.0;
+    }
+    for k in 0..=4 {
+        let x = xmax * k as f64 / 4.0;
+        s += &format!(
+            r##"<text x="{}" y="{}" text-anchor="middle" fill="#555">{x:.0}</text>
+"##,
+            px(x),
+            t + ph + 14.0
+        );
+    }
+    for (ci, c) in CURVES.iter().enumerate() {
+        let pts: Vec<(f64, f64, f64)> = rows
+            .iter()
+            .filter(|r| r.curve == ci)
+            .map(|r| (px(r.products), py(r.err_max.max(FLOOR).log10()), r.t))
+            .collect();
+        let line: Vec<String> = pts
+            .iter()
+            .map(|(x, y, _)| format!("{x:.1},{y:.1}"))
+            .collect();
+        s += &format!(
+            r#"<polyline points="{}" fill="none" stroke="{}" stroke-width="{}"/>
+"#,
+            line.join(" "),
+            c.color,
+            // The first curve is drawn wide so that curves on top of it stay visible.
+            if ci == 0 { 4.0 } else { 1.5 }
+        );
+        for (x, y, tt) in &pts {
+            s += &format!(
+                r#"<circle cx="{x:.1}" cy="{y:.1}" r="3.5" fill="{}"><title>{}: t = {tt:.0e}</title></circle>
+"#,
+                c.color, c.name
+            );
+        }
+        s += &format!(
+            r#"<circle cx="{}" cy="{}" r="4" fill="{}"/><text x="{}" y="{}">{}</text>
+"#,
+            l + 10.0 + (ci % 2) as f64 * 300.0,
+            h - 28.0 + (ci / 2) as f64 * 14.0,
+            c.color,
+            l + 18.0 + (ci % 2) as f64 * 300.0,
+            h - 24.0 + (ci / 2) as f64 * 14.0,
+            c.name
+        );
+    }
+    s + "</svg>\n"
+}
