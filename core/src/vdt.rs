@@ -1,0 +1,761 @@
+//! Visibility distance tables (rotatable-square-lights paper, section 4.3, Figure 7, eq. 9).
+//!
+//! A **visibility distance table** (VDT) of a binary visibility map `v` over the hemisphere's
+//! parametrisation square stores the signed distance `D(p) = sign(p)·d(p)` from each texel
+//! centre `p` to the visibility boundary: positive where `v(p) = 1` (visible), negative where
+//! `v(p) = 0` (occluded). The visible fraction of an axis-aligned square `R` (centre `p`,
+//! half-diagonal `r`) then takes **one** interpolated lookup instead of the four of a
+//! summed-area table.
+//!
+//! ## Grid and boundary (the definitions every function here uses)
+//!
+//! Texel `(i, j)` of a `w × h` map covers `[i, i+1]×[j, j+1]` in texel units (`i` along
+//! `u`, `j` along `v`, row-major storage `j·w + i`), as in [`crate::sat`]. The map is the
+//! piecewise-constant function of its texels, and its **boundary** `B` is the union of the
+//! texel edges that separate a visible texel from an occluded one (the border of the grid is
+//! not a boundary: nothing is known beyond it). `D` is sampled at texel centres:
+//!
+//! ```text
+//! D(i + ½, j + ½) = ±min_{q ∈ B} |(i + ½, j + ½) − q|        (+ visible, − occluded)
+//! ```
+//!
+//! the exact Euclidean distance from the centre to the boundary curve of the piecewise-
+//! constant map — the distance that makes eq. 9 integrate *that* map: a texel next to a
+//! texel of the other class has `|D| = ½`, a straight axis-aligned boundary gives `D` equal
+//! to the signed distance to that line at every centre, so the interpolated `D` is exact
+//! there and both queries below return the exact coverage of every square cut by such a
+//! boundary. (Centre-to-centre distances, the definition of most EDT libraries, are ½ too
+//! large for axis-aligned boundaries and would bias eq. 9 towards the texel's own class.)
+//! A map without any boundary (all visible or all occluded) has `D = ±`[`NO_BOUNDARY`].
+//!
+//! **Exactness.** [`signed_distance_into`] finds, for every texel, the exact squared distance
+//! (`k/4` for an integer `k`) and returns `(√k/2)` as the correctly rounded `f64` root
+//! rounded to `f32` (the harness checks it for bitwise equality against a brute-force
+//! minimum over every boundary edge, computed in `f64` the same way). The nearest point
+//! of `B` to a texel centre is a lattice corner on `B` or the midpoint of a boundary edge in
+//! the texel's own row or column; the distance transform of Felzenszwalb and Huttenlocher
+//! (2012, the paper's reference [4]) runs over the corners in doubled integer coordinates
+//! (a nearest-site sweep along `v`, then the lower envelope of parabolas along `u`), and two
+//! 1-D sweeps give the row and column runs. All squared distances are integers (exact in
+//! `f64`); the time is linear in the number of texels. (The rounding of an envelope
+//! intersection cannot reorder it across a query point: an intersection that is not exactly
+//! at a query point is at least `1/(4w)` away from one, far beyond `f64` rounding.)
+//!
+//! ## Queries
+//!
+//! `D(p)` at any point is the **bilinear** interpolation of the samples at the four nearest
+//! texel centres, `lerp(a, b, t) = (1 − t)·a + t·b` (exact at the centres), clamped to the
+//! edge outside the band of centres. Two estimates of the visible fraction of the square:
+//!
+//! - [`VdtView::eq9`], the paper's eq. 9: `clamp((√2·r + D)/(2√2·r), 0, 1)`, a ramp of width
+//!   `2√2·r` (four half-sides) in `D`. As printed it is exact only at `D = 0` (½, by
+//!   symmetry, for any orientation) and in the saturated tails: an axis-aligned edge needs a
+//!   ramp of width `2·(r/√2)`, a diagonal one a quadratic; it is off by up to ¼ at `|D|` ≈
+//!   one half-side (measured, harness `vdt` tests and the report).
+//! - [`VdtView::gradient`], the straight-edge variant: the gradient of the bilinear `D`
+//!   (the analytic gradient within the cell) gives the edge normal `n`, and the visible
+//!   fraction is the **exact** area of the square on the side `n·(x − p) ≥ −D` of that
+//!   straight line ([`square_halfplane_fraction`]). Exact for every square cut by one
+//!   straight edge along texel boundaries (any axis-aligned edge); for other boundaries its
+//!   error is the rasterisation of the boundary (the staircase of the binary map, ≲ ½ texel)
+//!   and its curvature within the square. A zero gradient (a map without boundary, or a
+//!   symmetric saddle) falls back to the normal `(1, 0)`.
+//!
+//! Queries are in texel units: centre `(u, v)`, half-diagonal `r` (half-side `r/√2`).
+//!
+//! **Bad input** (never panics). Constructors validate sizes, lengths and values and return
+//! [`Error`]. Queries saturate: `r` is clamped to `[`[`R_MIN`]`, `[`R_MAX`]`]` (so `r ≤ 0`
+//! queries the point `p`: 1 visible, 0 occluded, ½ on the boundary), infinite coordinates
+//! clamp to the edge of the table, and NaN in `u`, `v` or `r` gives NaN.
+
+use crate::Error;
+use crate::math;
+use core::f32::consts::SQRT_2;
+
+/// Largest width or height of a table: every texel coordinate is an exact `f32`, and every
+/// doubled squared distance an exact `f64` integer.
+pub const MAX_SIDE: usize = 1 << 24;
+
+/// `|D|` of a map without a boundary (every texel of one class): `2¹⁰⁰`, larger than any
+/// distance in a table of at most [`MAX_SIDE`]² texels and than `√2·`[`R_MAX`]`·2²⁰`, so both
+/// queries saturate to 1 (all visible) or 0 (all occluded) for every `r`, yet finite
+/// everywhere (WGSL promises nothing for infinities) and bilinear interpolation of it cannot
+/// overflow.
+pub const NO_BOUNDARY: f32 = 1.267_650_6e30;
+
+/// Smallest half-diagonal of a query (texel units); smaller ones (and `r ≤ 0`) are clamped
+/// up to it, which queries the point: 1, 0, or ½ exactly on the boundary.
+pub const R_MIN: f32 = 1.0e-12;
+/// Largest half-diagonal of a query (texel units), `2⁸⁰`; larger ones are clamped to it.
+pub const R_MAX: f32 = 1.208_925_8e24;
+
+/// Below this, the smaller normal component `q` of the straight-edge fraction is treated as
+/// this in the divisions of the two corner pieces (whose numerators are then at most `4q²`,
+/// so the result is the exact limit `q → 0` to within `q/2`).
+pub const Q_MIN: f32 = 1.0e-20;
+
+/// Length of the `f64` scratch buffer [`signed_distance_into`] needs for a `w × h` map:
+/// `(w + 1)·(h + 5)`.
+pub const fn scratch_len(w: usize, h: usize) -> usize {
+    (w + 1) * (h + 5)
+}
+
+fn check_shape(w: usize, h: usize) -> Result<(), Error> {
+    for (what, n) in [("VDT width", w), ("VDT height", h)] {
+        if n == 0 || n > MAX_SIDE {
+            return Err(Error::OutOfRange {
+                what,
+                value: n as f32,
+                min: 1.0,
+                max: MAX_SIDE as f32,
+            });
+        }
+    }
+    Ok(())
+}
+
+fn check_len(what: &'static str, got: usize, want: usize) -> Result<(), Error> {
+    if got != want {
+        return Err(Error::OutOfRange {
+            what,
+            value: got as f32,
+            min: want as f32,
+            max: want as f32,
+        });
+    }
+    Ok(())
+}
+
+/// The exact signed distance transform of a `w × h` binary map (`visible[j·w + i]`), written
+/// to `out` (same length) as defined in the module docs: `+d` at visible texels, `−d` at
+/// occluded ones, `±`[`NO_BOUNDARY`] when the map has a single class. Linear time; no
+/// allocation (`scratch` holds at least [`scratch_len`]`(w, h)` values; its contents on
+/// return are unspecified).
+///
+/// Errors: `w` or `h` zero or above [`MAX_SIDE`], `w·h` overflowing, `visible` or `out` of
+/// the wrong length, `scratch` too short.
+pub fn signed_distance_into(
+    w: usize,
+    h: usize,
+    visible: &[bool],
+    out: &mut [f32],
+    scratch: &mut [f64],
+) -> Result<(), Error> {
+    check_shape(w, h)?;
+    let n = w.checked_mul(h).ok_or(Error::OutOfRange {
+        what: "VDT texel count",
+        value: f32::INFINITY,
+        min: 1.0,
+        max: usize::MAX as f32,
+    })?;
+    check_len("visibility map length", visible.len(), n)?;
+    check_len("VDT output length", out.len(), n)?;
+    let need = scratch_len(w, h);
+    if scratch.len() < need {
+        return Err(Error::OutOfRange {
+            what: "VDT scratch length",
+            value: scratch.len() as f32,
+            min: need as f32,
+            max: f32::MAX,
+        });
+    }
+    // Doubled coordinates: lattice point (x, y) is (2x, 2y), texel centre (i, j) is
+    // (2i + 1, 2j + 1); every squared distance is an integer. The nearest point of B to a
+    // centre is a lattice point of B (a corner of the boundary), or the midpoint of a
+    // boundary edge in the centre's own column (a horizontal edge: the "column run") or own
+    // row (a vertical edge: the "row run"); a boundary-edge midpoint in another row or
+    // column is never nearest, one of its endpoints being closer.
+    let cols = w + 1;
+    let (g, rest) = scratch.split_at_mut(cols * h);
+    let (last, rest) = rest.split_at_mut(cols);
+    let (last_h, rest) = rest.split_at_mut(cols);
+    let (env_v, rest) = rest.split_at_mut(cols);
+    let (env_z, rest) = rest.split_at_mut(cols + 1);
+    let row_run = &mut rest[..w];
+    let row = |j: usize| &visible[j * w..(j + 1) * w];
+    // Lattice row y of B: `site[x]` for x = 0..=w (the up to four texels around (x, y) are
+    // not all of one class), written as the doubled coordinate 2y into `last[x]`.
+    let mark_sites = |y: usize, last: &mut [f64]| {
+        let yy = (2 * y) as f64;
+        match (
+            y.checked_sub(1).filter(|_| y <= h).map(row),
+            (y < h).then(|| row(y)),
+        ) {
+            (Some(a), Some(b)) => {
+                // x = 0 and x = w: two texels; inside: four.
+                if a[0] != b[0] {
+                    last[0] = yy;
+                }
+                if a[w - 1] != b[w - 1] {
+                    last[w] = yy;
+                }
+                for x in 1..w {
+                    let (p, q, r, t) = (a[x - 1], a[x], b[x - 1], b[x]);
+                    if (p != q) | (q != t) | (r != t) {
+                        last[x] = yy;
+                    }
+                }
+            }
+            (Some(a), None) | (None, Some(a)) => {
+                // The top or bottom border: two texels per interior point, one at the ends.
+                for x in 1..w {
+                    if a[x - 1] != a[x] {
+                        last[x] = yy;
+                    }
+                }
+            }
+            (None, None) => {}
+        }
+    };
+    let inf = f64::INFINITY;
+    // Pass 1, along v. Upward sweep: nearest lattice site at or below each centre row
+    // (into g) and nearest horizontal boundary edge at or below in the texel's column
+    // (the column run, into `out` as a doubled distance, an exact small integer).
+    last.fill(-inf);
+    last_h.fill(-inf);
+    for j in 0..h {
+        mark_sites(j, last);
+        if j > 0 {
+            let (a, b) = (row(j - 1), row(j));
+            for i in 0..w {
+                if a[i] != b[i] {
+                    last_h[i] = (2 * j) as f64;
+                }
+            }
+        }
+        let yc = (2 * j + 1) as f64;
+        for (gv, &l) in g[j * cols..(j + 1) * cols].iter_mut().zip(last.iter()) {
+            let d = yc - l;
+            *gv = d * d;
+        }
+        for (o, &l) in out[j * w..(j + 1) * w].iter_mut().zip(last_h.iter()) {
+            *o = (yc - l) as f32;
+        }
+    }
+    // Downward sweep: the same from above, keeping the smaller.
+    last.fill(inf);
+    last_h.fill(inf);
+    for j in (0..h).rev() {
+        mark_sites(j + 1, last);
+        if j + 1 < h {
+            let (a, b) = (row(j), row(j + 1));
+            for i in 0..w {
+                if a[i] != b[i] {
+                    last_h[i] = (2 * j + 2) as f64;
+                }
+            }
+        }
+        let yc = (2 * j + 1) as f64;
+        for (gv, &l) in g[j * cols..(j + 1) * cols].iter_mut().zip(last.iter()) {
+            let d = l - yc;
+            let d2 = d * d;
+            if d2 < *gv {
+                *gv = d2;
+            }
+        }
+        for (o, &l) in out[j * w..(j + 1) * w].iter_mut().zip(last_h.iter()) {
+            let d = (l - yc) as f32;
+            if d < *o {
+                *o = d;
+            }
+        }
+    }
+    // Pass 2, along u, per centre row: the row run (two sweeps), then the lower envelope of
+    // the parabolas (Q − X)² + g[x] over the lattice columns X = 2x, evaluated at the
+    // centres Q = 2i + 1 (Felzenszwalb–Huttenlocher), and the minimum of the three.
+    let mut any_boundary = false;
+    for j in 0..h {
+        let m = row(j);
+        let mut l = -inf;
+        for i in 0..w {
+            if i > 0 && m[i - 1] != m[i] {
+                l = (2 * i) as f64;
+            }
+            row_run[i] = (2 * i + 1) as f64 - l;
+        }
+        let mut r = inf;
+        for i in (0..w).rev() {
+            if i + 1 < w && m[i] != m[i + 1] {
+                r = (2 * i + 2) as f64;
+            }
+            let d = r - (2 * i + 1) as f64;
+            if d < row_run[i] {
+                row_run[i] = d;
+            }
+        }
+        let gr = &g[j * cols..(j + 1) * cols];
+        let mut k = 0usize;
+        let mut any = false;
+        for (x, &gx) in gr.iter().enumerate() {
+            if gx == inf {
+                continue;
+            }
+            let q = (2 * x) as f64;
+            if !any {
+                env_v[0] = q;
+                env_z[0] = -inf;
+                env_z[1] = inf;
+                any = true;
+                continue;
+            }
+            loop {
+                let p = env_v[k];
+                let gp = gr[(p as usize) / 2];
+                // Intersection of the parabolas of p and q (q > p). Exact integer inputs;
+                // the rounding of s cannot move it across a query point (module docs).
+                let s = ((gx + q * q) - (gp + p * p)) / (2.0 * (q - p));
+                if s <= env_z[k] {
+                    // k ≥ 1 here: env_z[0] = −∞ < s.
+                    k -= 1;
+                } else {
+                    k += 1;
+                    env_v[k] = q;
+                    env_z[k] = s;
+                    env_z[k + 1] = inf;
+                    break;
+                }
+            }
+        }
+        any_boundary |= any;
+        let out_row = &mut out[j * w..(j + 1) * w];
+        let mut k = 0usize;
+        for i in 0..w {
+            let qq = (2 * i + 1) as f64;
+            let mut d2 = inf;
+            if any {
+                while env_z[k + 1] < qq {
+                    k += 1;
+                }
+                let p = env_v[k];
+                d2 = (qq - p) * (qq - p) + gr[(p as usize) / 2];
+            }
+            let c = out_row[i] as f64;
+            let rr = row_run[i];
+            d2 = d2.min(c * c).min(rr * rr);
+            out_row[i] = if d2 == inf {
+                0.0
+            } else {
+                // √(d2)/2, d2 ≥ 1: the nearest boundary point is at least ½ away.
+                (sqrt64(d2) * 0.5) as f32
+            };
+            if !m[i] {
+                out_row[i] = -out_row[i];
+            }
+        }
+    }
+    if !any_boundary {
+        // No lattice site anywhere: the map has a single class (every boundary edge has
+        // two lattice endpoints on B).
+        let d = if visible[0] {
+            NO_BOUNDARY
+        } else {
+            -NO_BOUNDARY
+        };
+        out.fill(d);
+    }
+    Ok(())
+}
+
+/// `√x` in `f64` (correctly rounded: the standard library's or `libm`'s).
+#[cfg(feature = "std")]
+#[inline(always)]
+fn sqrt64(x: f64) -> f64 {
+    x.sqrt()
+}
+/// `√x` in `f64` (correctly rounded: the standard library's or `libm`'s).
+#[cfg(all(not(feature = "std"), feature = "libm"))]
+#[inline(always)]
+fn sqrt64(x: f64) -> f64 {
+    libm::sqrt(x)
+}
+/// Unreachable: the crate root emits a `compile_error!` without a math backend.
+#[cfg(not(any(feature = "std", feature = "libm")))]
+#[inline(always)]
+fn sqrt64(x: f64) -> f64 {
+    x
+}
+
+/// The exact fraction of the square `[−1, 1]²` on the side `x·nx + y·ny ≥ −t` of a straight
+/// line, for a normal `(nx, ny)` (any length, not both zero: it is normalised here; a zero
+/// normal falls back to `(1, 0)`) and `t` the signed distance of the line from the centre in
+/// units of the half-side (`t > 0`: the centre is on the visible side).
+///
+/// With `q = min(|nx|, |ny|)/max(|nx|, |ny|)` and `T = t·√(1 + q²)` clamped to `±(1 + q)`
+/// (`X = x + q·y` has a trapezoidal density on `[−1−q, 1+q]`):
+///
+/// ```text
+/// T ≤ q − 1:  (T + 1 + q)²/(8q)
+/// T ≥ 1 − q:  1 − (1 + q − T)²/(8q)
+/// otherwise:  (T + 1)/2
+/// ```
+///
+/// the divisions by `max(q, `[`Q_MIN`]`)`. Within a few `f32` ulps of the exact fraction
+/// (harness test against `f64` polygon clipping). NaN `t` gives NaN; `±∞` gives 1 or 0.
+#[inline]
+pub fn square_halfplane_fraction(t: f32, nx: f32, ny: f32) -> f32 {
+    let (ax, ay) = (nx.abs(), ny.abs());
+    let m = ax.max(ay);
+    let q = if m > 0.0 { ax.min(ay) / m } else { 0.0 };
+    edge_fraction(t, q)
+}
+
+/// [`square_halfplane_fraction`] after the normal has been reduced to `q ∈ [0, 1]`.
+#[inline(always)]
+fn edge_fraction(t: f32, q: f32) -> f32 {
+    let len = math::sqrtf(1.0 + q * q);
+    let hi = 1.0 + q;
+    let tt = (t * len).clamp(-hi, hi);
+    let den = 8.0 * q.max(Q_MIN);
+    // All three pieces, then a choice (compiled to selects, not branches: random queries
+    // fall on all three).
+    let lo_e = tt + hi;
+    let lo_v = lo_e * lo_e / den;
+    let hi_e = hi - tt;
+    let hi_v = 1.0 - hi_e * hi_e / den;
+    let mid = (tt + 1.0) * 0.5;
+    let r = if tt >= 1.0 - q { hi_v } else { mid };
+    if tt <= q - 1.0 { lo_v } else { r }
+}
+
+/// `(1 − t)·a + t·b`: exact at `t = 0` and `t = 1`.
+#[inline(always)]
+fn lerp(a: f32, b: f32, t: f32) -> f32 {
+    (1.0 - t) * a + t * b
+}
+
+/// The four samples and fractions of a bilinear lookup.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Cell {
+    /// `D` at the centres `(i0, j0)`, `(i1, j0)`, `(i0, j1)`, `(i1, j1)`.
+    pub d: [f32; 4],
+    /// Fractions along `u` and `v`, in `[0, 1]` (NaN for a NaN coordinate).
+    pub fx: f32,
+    /// See `fx`.
+    pub fy: f32,
+}
+
+/// `D` and its gradient at a point.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Sample {
+    /// Interpolated signed distance (texel units).
+    pub d: f32,
+    /// `∂D/∂u` of the bilinear interpolant within its cell.
+    pub gx: f32,
+    /// `∂D/∂v` of the bilinear interpolant within its cell.
+    pub gy: f32,
+}
+
+/// Column index `i0` (as `f32`), the fraction, and the step to `i1` for one axis of
+/// `len` centres at coordinate `x` (texel units, centres at `k + ½`).
+#[inline(always)]
+pub fn axis(x: f32, len: usize) -> (f32, f32) {
+    let c = x - 0.5;
+    let hi_index = if len >= 2 { (len - 2) as f32 } else { 0.0 };
+    let hi_frac = if len >= 2 { 1.0 } else { 0.0 };
+    let i0 = math::floorf(c).clamp(0.0, hi_index);
+    let f = (c - i0).clamp(0.0, hi_frac);
+    (i0, f)
+}
+
+/// A borrowed visibility distance table: `w × h` samples of `D`, row-major. The lookup
+/// side (no allocation), e.g. over a table loaded from bytes or a GPU readback.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct VdtView<'a> {
+    w: usize,
+    h: usize,
+    d: &'a [f32],
+}
+
+impl<'a> VdtView<'a> {
+    /// A view of `d` (`w·h` values, row-major). Every value must be finite with
+    /// `|D| ≤ `[`NO_BOUNDARY`] (so interpolation and gradients cannot overflow).
+    pub fn new(w: usize, h: usize, d: &'a [f32]) -> Result<Self, Error> {
+        check_shape(w, h)?;
+        let n = w.checked_mul(h).ok_or(Error::OutOfRange {
+            what: "VDT texel count",
+            value: f32::INFINITY,
+            min: 1.0,
+            max: usize::MAX as f32,
+        })?;
+        check_len("VDT length", d.len(), n)?;
+        for &x in d {
+            if !x.is_finite() {
+                return Err(Error::NonFinite { what: "VDT sample" });
+            }
+            if x.abs() > NO_BOUNDARY {
+                return Err(Error::OutOfRange {
+                    what: "VDT sample",
+                    value: x,
+                    min: -NO_BOUNDARY,
+                    max: NO_BOUNDARY,
+                });
+            }
+        }
+        Ok(VdtView { w, h, d })
+    }
+
+    /// Width in texels.
+    pub fn width(&self) -> usize {
+        self.w
+    }
+    /// Height in texels.
+    pub fn height(&self) -> usize {
+        self.h
+    }
+    /// The samples, row-major.
+    pub fn samples(&self) -> &'a [f32] {
+        self.d
+    }
+
+    /// The four samples around `(u, v)` and the bilinear fractions (clamped to the edge).
+    #[inline(always)]
+    pub fn cell(&self, u: f32, v: f32) -> Cell {
+        let (i0, fx) = axis(u, self.w);
+        let (j0, fy) = axis(v, self.h);
+        // `as usize` saturates and maps NaN to 0: always in range.
+        let (i0, j0) = (i0 as usize, j0 as usize);
+        let i1 = (i0 + 1).min(self.w - 1);
+        let j1 = (j0 + 1).min(self.h - 1);
+        let at = |i: usize, j: usize| self.d.get(j * self.w + i).copied().unwrap_or(0.0);
+        Cell {
+            d: [at(i0, j0), at(i1, j0), at(i0, j1), at(i1, j1)],
+            fx,
+            fy,
+        }
+    }
+
+    /// `D` (bilinear) and its gradient at `(u, v)` (texel units).
+    #[inline]
+    pub fn sample(&self, u: f32, v: f32) -> Sample {
+        sample_cell(self.cell(u, v))
+    }
+
+    /// `D` at `(u, v)`, bilinear.
+    #[inline]
+    pub fn distance(&self, u: f32, v: f32) -> f32 {
+        self.sample(u, v).d
+    }
+
+    /// The visible fraction of the square with centre `(u, v)` and half-diagonal `r` by the
+    /// paper's eq. 9: `clamp((√2·r + D)/(2√2·r), 0, 1)`.
+    #[inline]
+    pub fn eq9(&self, u: f32, v: f32, r: f32) -> f32 {
+        eq9_from(self.sample(u, v).d, r)
+    }
+
+    /// The visible fraction of the same square by the straight-edge variant (module docs).
+    #[inline]
+    pub fn gradient(&self, u: f32, v: f32, r: f32) -> f32 {
+        gradient_from(self.sample(u, v), r)
+    }
+
+    /// Both estimates, `(eq9, gradient)`, from one lookup.
+    #[inline]
+    pub fn query(&self, u: f32, v: f32, r: f32) -> (f32, f32) {
+        let s = self.sample(u, v);
+        (eq9_from(s.d, r), gradient_from(s, r))
+    }
+}
+
+/// Bilinear value and in-cell gradient of a [`Cell`].
+#[inline(always)]
+pub fn sample_cell(c: Cell) -> Sample {
+    let [d00, d10, d01, d11] = c.d;
+    let d0 = lerp(d00, d10, c.fx);
+    let d1 = lerp(d01, d11, c.fx);
+    Sample {
+        d: lerp(d0, d1, c.fy),
+        gx: lerp(d10 - d00, d11 - d01, c.fy),
+        gy: lerp(d01 - d00, d11 - d10, c.fx),
+    }
+}
+
+/// `r` clamped to `[R_MIN, R_MAX]`, NaN kept.
+#[inline(always)]
+fn clamp_r(r: f32) -> f32 {
+    r.clamp(R_MIN, R_MAX)
+}
+
+/// Eq. 9 for a sampled `D`: `clamp((√2·r + D)/(2√2·r), 0, 1)`, `r` clamped to
+/// `[R_MIN, R_MAX]`.
+#[inline(always)]
+pub fn eq9_from(d: f32, r: f32) -> f32 {
+    let k = SQRT_2 * clamp_r(r);
+    ((k + d) / (2.0 * k)).clamp(0.0, 1.0)
+}
+
+/// The straight-edge fraction for a sampled `D` and gradient: the square of half-side
+/// `r/√2` cut by the line at signed distance `D` with normal along the gradient.
+#[inline(always)]
+pub fn gradient_from(s: Sample, r: f32) -> f32 {
+    let (ax, ay) = (s.gx.abs(), s.gy.abs());
+    let m = ax.max(ay);
+    let q = if m > 0.0 { ax.min(ay) / m } else { 0.0 };
+    // D in units of the half-side r/√2.
+    let t = s.d * SQRT_2 / clamp_r(r);
+    edge_fraction(t, q)
+}
+
+#[cfg(feature = "alloc")]
+pub use owned::Vdt;
+
+#[cfg(feature = "alloc")]
+mod owned {
+    use super::*;
+    use alloc::vec;
+    use alloc::vec::Vec;
+
+    /// An owned visibility distance table.
+    #[derive(Clone, Debug, PartialEq)]
+    pub struct Vdt {
+        w: usize,
+        h: usize,
+        d: Vec<f32>,
+    }
+
+    impl Vdt {
+        /// The VDT of a `w × h` binary map (`visible[j·w + i]`), exact
+        /// ([`signed_distance_into`]).
+        pub fn build(w: usize, h: usize, visible: &[bool]) -> Result<Vdt, Error> {
+            check_shape(w, h)?;
+            let n = w.checked_mul(h).ok_or(Error::OutOfRange {
+                what: "VDT texel count",
+                value: f32::INFINITY,
+                min: 1.0,
+                max: usize::MAX as f32,
+            })?;
+            check_len("visibility map length", visible.len(), n)?;
+            let mut d = vec![0.0f32; n];
+            let mut scratch = vec![0.0f64; scratch_len(w, h)];
+            signed_distance_into(w, h, visible, &mut d, &mut scratch)?;
+            Ok(Vdt { w, h, d })
+        }
+
+        /// The VDT of a coverage map (visible fraction per texel, finite): a texel is
+        /// visible when its coverage is at least ½.
+        pub fn from_coverage(w: usize, h: usize, coverage: &[f32]) -> Result<Vdt, Error> {
+            if coverage.iter().any(|c| !c.is_finite()) {
+                return Err(Error::NonFinite { what: "coverage" });
+            }
+            let mask: Vec<bool> = coverage.iter().map(|&c| c >= 0.5).collect();
+            Self::build(w, h, &mask)
+        }
+
+        /// An owned table from samples (validated as in [`VdtView::new`]).
+        pub fn from_samples(w: usize, h: usize, d: Vec<f32>) -> Result<Vdt, Error> {
+            VdtView::new(w, h, &d)?;
+            Ok(Vdt { w, h, d })
+        }
+
+        /// The lookup view.
+        pub fn view(&self) -> VdtView<'_> {
+            VdtView {
+                w: self.w,
+                h: self.h,
+                d: &self.d,
+            }
+        }
+        /// Width in texels.
+        pub fn width(&self) -> usize {
+            self.w
+        }
+        /// Height in texels.
+        pub fn height(&self) -> usize {
+            self.h
+        }
+        /// The samples, row-major.
+        pub fn samples(&self) -> &[f32] {
+            &self.d
+        }
+        /// The table in the layout of `wgsl::VDT_QUERY` (binding 3): `[w, h]` as `f32`,
+        /// then the samples row-major.
+        pub fn gpu_table(&self) -> Vec<f32> {
+            let mut t = Vec::with_capacity(self.d.len() + 2);
+            t.push(self.w as f32);
+            t.push(self.h as f32);
+            t.extend_from_slice(&self.d);
+            t
+        }
+        /// [`VdtView::query`].
+        pub fn query(&self, u: f32, v: f32, r: f32) -> (f32, f32) {
+            self.view().query(u, v, r)
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn build(w: usize, h: usize, m: &[bool]) -> [f32; 64] {
+        let mut out = [0.0f32; 64];
+        let mut scratch = [0.0f64; 512];
+        signed_distance_into(w, h, m, &mut out[..w * h], &mut scratch).unwrap();
+        out
+    }
+
+    #[test]
+    fn vertical_edge_is_linear_and_queries_exact() {
+        // 4 × 2, columns 0,1 occluded, 2,3 visible: edge at u = 2.
+        let m = [false, false, true, true, false, false, true, true];
+        let d = build(4, 2, &m);
+        assert_eq!(&d[..4], &[-1.5, -0.5, 0.5, 1.5]);
+        let v = VdtView::new(4, 2, &d[..8]).unwrap();
+        // Square of half-side 1 at u = 2.5: visible fraction (2.5 + 1 − 2)/2 = 0.75.
+        let r = SQRT_2;
+        let (e9, g) = v.query(2.5, 1.0, r);
+        assert!((g - 0.75).abs() < 1e-6, "{g}");
+        // eq. 9 as printed: (2 + 0.5)/4.
+        assert!((e9 - 0.625).abs() < 1e-6, "{e9}");
+    }
+
+    #[test]
+    fn uniform_maps_saturate() {
+        let d = build(3, 2, &[true; 6]);
+        assert!(d[..6].iter().all(|&x| x == NO_BOUNDARY));
+        let v = VdtView::new(3, 2, &d[..6]).unwrap();
+        for r in [0.0, 1e-30, 1.0, 1e20, f32::INFINITY] {
+            assert_eq!(v.query(1.0, 1.0, r), (1.0, 1.0), "r = {r}");
+        }
+        let d = build(3, 2, &[false; 6]);
+        let v = VdtView::new(3, 2, &d[..6]).unwrap();
+        assert_eq!(v.query(-5.0, 1e30, 3.0), (0.0, 0.0));
+    }
+
+    #[test]
+    fn bad_input() {
+        let mut s = [0.0f64; 8];
+        let mut o = [0.0f32; 2];
+        assert!(signed_distance_into(0, 1, &[], &mut o[..0], &mut s).is_err());
+        assert!(signed_distance_into(2, 1, &[true], &mut o, &mut s).is_err());
+        assert!(signed_distance_into(2, 1, &[true, false], &mut o, &mut s[..1]).is_err());
+        assert!(VdtView::new(1, 1, &[f32::NAN]).is_err());
+        assert!(VdtView::new(1, 1, &[3e30]).is_err());
+        let d = [0.5f32, -0.5];
+        let v = VdtView::new(2, 1, &d).unwrap();
+        assert!(v.eq9(f32::NAN, 0.5, 1.0).is_nan());
+        assert!(v.gradient(1.0, 0.5, f32::NAN).is_nan());
+        assert!(v.gradient(f32::NAN, 0.5, 1.0).is_nan());
+        // Point queries: r ≤ 0.
+        assert_eq!(v.query(0.5, 0.5, 0.0), (1.0, 1.0));
+        assert_eq!(v.query(1.5, 0.5, -1.0), (0.0, 0.0));
+        assert_eq!(v.query(1.0, 0.5, 0.0), (0.5, 0.5));
+        // Infinite coordinates clamp to the edge.
+        assert_eq!(v.query(f32::INFINITY, 0.5, 0.0), (0.0, 0.0));
+        assert_eq!(v.query(f32::NEG_INFINITY, 0.5, 0.0), (1.0, 1.0));
+    }
+
+    #[test]
+    fn halfplane_fraction_limits() {
+        assert_eq!(square_halfplane_fraction(0.0, 0.3, -0.7), 0.5);
+        assert_eq!(square_halfplane_fraction(10.0, 1.0, 1.0), 1.0);
+        assert_eq!(square_halfplane_fraction(-10.0, 1.0, 1.0), 0.0);
+        assert_eq!(square_halfplane_fraction(0.5, 0.0, 0.0), 0.75);
+        // Diagonal: the corner triangle beyond distance t = 1/√2·(…): at t = 0 on the
+        // diagonal, ½; at the corner (t = −√2) 0.
+        assert_eq!(square_halfplane_fraction(-1.5, 1.0, 1.0), 0.0);
+        assert!(square_halfplane_fraction(-SQRT_2, 1.0, 1.0) < 1e-6);
+        assert!(square_halfplane_fraction(f32::NAN, 1.0, 0.0).is_nan());
+        assert_eq!(square_halfplane_fraction(f32::INFINITY, 1.0, 0.2), 1.0);
+    }
+}
