@@ -47,6 +47,9 @@ use crate::math;
 use crate::table::{HEADER_LEN, Header, TableError, TableView};
 use crate::{TWO_PI, Vec3};
 
+/// `ln 2π`.
+const LN_TWO_PI: f32 = 1.837_877_1;
+
 /// Name of the product table in its header.
 pub const TABLE_NAME: &str = "lobe-product";
 /// Exponent samples of the built-in table.
@@ -469,18 +472,36 @@ pub fn product_with(
     let (ct, st) = base.peak_dir;
     let axis = a.axis() * ct + w * st;
     let scale = a.scale() * b.scale();
+    if e1.is_nan() || e2.is_nan() {
+        // A NaN exponent is not silently taken as 0 (the clamps above would).
+        return CosineLobe::saturating(axis, f32::NAN, f32::NAN);
+    }
     if ln_i == f32::NEG_INFINITY {
         return CosineLobe::saturating(axis, 0.0 * scale, 0.0);
     }
+    // s1·s2·exp(ln q), without `∞·0` when s1·s2 overflows but the product does not.
+    let scaled = |ln_q: f32| {
+        let q = math::expf(ln_q);
+        if scale.is_finite() || scale.is_nan() {
+            scale * q
+        } else {
+            a.scale() * (b.scale() * q)
+        }
+    };
     if fit == ProductFit::ExactIntegralCurvature {
         let e_r = math::sqrtf((e1.max(0.0) + e2.max(0.0)) * base.arc_curvature);
-        // p·2π/(e_r + 1) = I.
-        let p = math::expf(ln_i) * (e_r + 1.0) * (1.0 / TWO_PI);
-        return CosineLobe::saturating(axis, scale * p, e_r);
+        // A peak on an e < 1 lobe's horizon has no curvature to match (the lobe has a
+        // kink there): the peak-matched exponent below takes over.
+        if e_r.is_finite() {
+            // p·2π/(e_r + 1) = I, with p = exp(ln I + ln((e_r + 1)/2π)) so that a tiny
+            // `I` with a large `e_r` does not lose `p` to underflow.
+            let p = ln_i + math::logf((e_r + 1.0) * (1.0 / TWO_PI));
+            return CosineLobe::saturating(axis, scaled(p), e_r);
+        }
     }
     // 2π·peak/(e_r + 1) = I.
-    let e_r = math::expf(math::logf(TWO_PI) + base.ln_peak - ln_i) - 1.0;
-    CosineLobe::saturating(axis, scale * math::expf(base.ln_peak), e_r.max(0.0))
+    let e_r = math::expf(LN_TWO_PI + base.ln_peak - ln_i) - 1.0;
+    CosineLobe::saturating(axis, scaled(base.ln_peak), e_r.max(0.0))
 }
 
 /// The spherical-Gaussian closed form with the exact peak (no table). See

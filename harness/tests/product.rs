@@ -379,3 +379,34 @@ fn report_section_orders_tables_by_error() {
             .any(|(f, b)| f.ends_with(".svg") && b.starts_with(b"<svg"))
     );
 }
+
+/// Regressions the SIMD fuzzing found in the scalar kernel: a curvature fit whose peak sits
+/// on a near-zero exponent's horizon, NaN exponents, and scales whose product overflows.
+#[test]
+fn curvature_fit_nan_exponents_and_overflowing_scales() {
+    let alpha = 150f64.to_radians();
+    let (a, b) = lobes(3.6e-35, 322.0, alpha);
+    for fit in [ProductFit::ExactIntegral, ProductFit::ExactIntegralCurvature] {
+        let r = product::product_with(&ProductTable::builtin(), fit, &a, &b);
+        assert!(
+            r.exponent().is_finite() && r.scale().is_finite() && r.scale() >= 0.0,
+            "{fit:?}: {r:?}"
+        );
+        if let Some(rel) = check(3.6e-35, 322.0, alpha, fit) {
+            assert!(rel <= INTEGRAL_REL_MAX, "{fit:?}: {rel:.2e}");
+        }
+    }
+    let nan = CosineLobe::saturating(Vec3::Z, 1.0, f32::NAN);
+    let r = product::product(&nan, &b);
+    assert!(r.scale().is_nan() && r.exponent().is_nan(), "{r:?}");
+    // 1e30·1e30 overflows f32, the peak (e^(−200)-ish) brings it back into range or to 0.
+    let big1 = CosineLobe::saturating(Vec3::Z, 1e30, 1000.0);
+    let big2 = CosineLobe::saturating(Vec3::new(0.5f32.sin(), 0.0, 0.5f32.cos()), 1e30, 1000.0);
+    let r = product::product(&big1, &big2);
+    assert!(r.scale().is_finite() && r.scale() >= 0.0, "{r:?}");
+    let unit = product::product(
+        &CosineLobe::saturating(big1.axis(), 1.0, 1000.0),
+        &CosineLobe::saturating(big2.axis(), 1.0, 1000.0),
+    );
+    assert!((r.scale() as f64 / (unit.scale() as f64 * 1e60) - 1.0).abs() < 1e-5);
+}

@@ -48,6 +48,12 @@ pub(crate) trait Lanes:
     fn ceil(self) -> Self;
     fn exp(self) -> Self;
     fn ln_1p(self) -> Self;
+    fn ln(self) -> Self;
+    fn exp_m1(self) -> Self;
+    /// `atan2(self, x)`.
+    fn atan2(self, x: Self) -> Self;
+    /// Round toward zero (IEEE `trunc`, exact).
+    fn trunc(self) -> Self;
     fn is_nan(self) -> Self;
     /// x86 `maxps` semantics where the build has SSE: `if self > o { self } else { o }`.
     fn fast_max(self, o: Self) -> Self;
@@ -111,6 +117,22 @@ macro_rules! impl_lanes {
             #[inline(always)]
             fn ln_1p(self) -> Self {
                 $t::ln_1p(self)
+            }
+            #[inline(always)]
+            fn ln(self) -> Self {
+                $t::ln(self)
+            }
+            #[inline(always)]
+            fn exp_m1(self) -> Self {
+                $t::exp_m1(self)
+            }
+            #[inline(always)]
+            fn atan2(self, x: Self) -> Self {
+                $t::atan2(self, x)
+            }
+            #[inline(always)]
+            fn trunc(self) -> Self {
+                $t::trunc(self)
             }
             #[inline(always)]
             fn is_nan(self) -> Self {

@@ -154,9 +154,94 @@ fn time_scalar(
     t.elapsed()
 }
 
+/// Batch throughput of the built-in table: `(cpu-simd products/s, wgpu products/s or why
+/// not)`, timed in turns with the scalar kernel, and the scalar rate of the same run.
+fn batch_speeds(
+    lobes: &[(CosineLobe, CosineLobe)],
+    gpu: bool,
+) -> (f64, f64, Result<(f64, String), String>) {
+    let n = lobes.len();
+    let col = |f: &dyn Fn(&(CosineLobe, CosineLobe)) -> f32| -> Vec<f32> { lobes.iter().map(f).collect() };
+    let a_axis = [col(&|l| l.0.axis().x), col(&|l| l.0.axis().y), col(&|l| l.0.axis().z)];
+    let b_axis = [col(&|l| l.1.axis().x), col(&|l| l.1.axis().y), col(&|l| l.1.axis().z)];
+    let (a_s, a_e) = (col(&|l| l.0.scale()), col(&|l| l.0.exponent()));
+    let (b_s, b_e) = (col(&|l| l.1.scale()), col(&|l| l.1.exponent()));
+    let mut out = [vec![0f32; n], vec![0f32; n], vec![0f32; n], vec![0f32; n], vec![0f32; n]];
+    let table = ProductTable::builtin();
+    let mut gpu_state = if gpu {
+        crate::backend::gpu::try_gpu().map(|g| {
+            let info = g.adapter_info();
+            (g, info)
+        })
+    } else {
+        Err("--no-gpu".to_string())
+    };
+    let rows: Vec<[f32; 10]> = lobes
+        .iter()
+        .map(|(x, y)| {
+            let (p, q) = (x.axis(), y.axis());
+            [p.x, p.y, p.z, x.scale(), x.exponent(), q.x, q.y, q.z, y.scale(), y.exponent()]
+        })
+        .collect();
+    let input = crate::kernels::Columns::from_rows(&rows);
+    let mut gout = crate::kernels::Columns::zeros(5, n);
+    let gtable = crate::backend::gpu_product::ProductGpuTable::builtin();
+    let mut scalar_out = vec![lobes[0].0; n];
+    let (mut ts, mut tv, mut tg) = (Vec::new(), Vec::new(), Vec::new());
+    let mut gpu_err = None;
+    for rep in 0..=REPEATS {
+        let d = time_scalar(&table, ProductFit::ExactIntegral, lobes, &mut scalar_out);
+        let t = Instant::now();
+        {
+            let [o0, o1, o2, o3, o4] = &mut out;
+            steradian_simd::product::product_slices(
+                &table,
+                ProductFit::ExactIntegral,
+                [&a_axis[0], &a_axis[1], &a_axis[2]],
+                &a_s,
+                &a_e,
+                [&b_axis[0], &b_axis[1], &b_axis[2]],
+                &b_s,
+                &b_e,
+                [o0, o1, o2],
+                o3,
+                o4,
+            );
+        }
+        black_box(&out);
+        let dv = t.elapsed();
+        if let (Ok((g, _)), Ok(gt), None) = (&mut gpu_state, &gtable, &gpu_err) {
+            let t = Instant::now();
+            match crate::backend::gpu_product::run_lobe_product_columns(g, gt, &input, &mut gout) {
+                Ok(()) if rep > 0 => tg.push(t.elapsed()),
+                Ok(()) => {}
+                Err(e) => gpu_err = Some(e.to_string()),
+            }
+        }
+        if rep > 0 {
+            ts.push(d);
+            tv.push(dv);
+        }
+    }
+    let rate = |v: &mut Vec<Duration>| {
+        v.sort();
+        n as f64 / v[v.len() / 2].as_secs_f64().max(1e-12)
+    };
+    let gpu = match (gpu_state, gpu_err) {
+        (Err(why), _) => Err(why),
+        (_, Some(e)) => Err(e),
+        (Ok((_, info)), None) if !tg.is_empty() => Ok((rate(&mut tg), info)),
+        (Ok(_), None) => Err(match gtable {
+            Err(e) => e.to_string(),
+            Ok(_) => "no timing".into(),
+        }),
+    };
+    (rate(&mut ts), rate(&mut tv), gpu)
+}
+
 /// Runs the section.
-pub fn section(_opts: &Options) -> Result<Section, Box<dyn Error>> {
-    let steps = (RESOLUTIONS.len() + 4) as u64;
+pub fn section(opts: &Options) -> Result<Section, Box<dyn Error>> {
+    let steps = (RESOLUTIONS.len() + 5) as u64;
     let bar = ProgressBar::new(steps).with_style(
         ProgressStyle::with_template("{spinner} [{elapsed_precise}] {bar:30} {pos}/{len} {msg}")
             .unwrap_or_else(|_| ProgressStyle::default_bar()),
@@ -247,6 +332,8 @@ pub fn section(_opts: &Options) -> Result<Section, Box<dyn Error>> {
             }
         })
         .collect();
+    bar.set_message("lobe products: SIMD and wgpu throughput");
+    let (batch_scalar, batch_simd, batch_gpu) = batch_speeds(&lobes, opts.gpu);
     bar.inc(1);
 
     bar.set_message("lobe products: shape errors");
@@ -371,6 +458,34 @@ pub fn section(_opts: &Options) -> Result<Section, Box<dyn Error>> {
         }));
     }
     html += "</table>\n";
+    let simd_ratio = batch_simd / batch_scalar;
+    let gpu_line = match &batch_gpu {
+        Ok((r, info)) => format!(
+            "wgpu {:.2} M/s ({:.2}× scalar, upload and read-back included, on {info})",
+            r / 1e6,
+            r / batch_scalar
+        ),
+        Err(why) => format!("wgpu: not run ({why})"),
+    };
+    let _ = writeln!(
+        summary,
+        "  built-in table, same run: cpu-scalar {:.2} M/s, cpu-simd {:.2} M/s ({:.2}× scalar, {} lanes, {}), {gpu_line}",
+        batch_scalar / 1e6,
+        batch_simd / 1e6,
+        simd_ratio,
+        steradian_simd::slice_lanes(),
+        steradian_simd::isa()
+    );
+    html += &format!(
+        "<p>Batches with the built-in table, timed in turns in this run: cpu-scalar {:.2} M products/s, \
+         cpu-simd {:.2} M/s (<b>{:.2}×</b> scalar, {} lanes, {}), {}.</p>\n",
+        batch_scalar / 1e6,
+        batch_simd / 1e6,
+        simd_ratio,
+        steradian_simd::slice_lanes(),
+        steradian_simd::isa(),
+        gpu_line
+    );
     let _ = writeln!(
         summary,
         "  contract for the built-in table: mean ≤ {:.0e}, p99 ≤ {:.0e}, max ≤ {:.0e}",
@@ -456,7 +571,17 @@ pub fn section(_opts: &Options) -> Result<Section, Box<dyn Error>> {
         title: "Lobe products".into(),
         summary,
         html,
-        data: json!({ "tables": json_rows, "shape_error": json_shapes, "third_lobe_error": json_renders }),
+        data: json!({
+            "tables": json_rows,
+            "shape_error": json_shapes,
+            "third_lobe_error": json_renders,
+            "batch": {
+                "cpu_scalar_per_s": batch_scalar,
+                "cpu_simd_per_s": batch_simd,
+                "simd_over_scalar": simd_ratio,
+                "wgpu_per_s": batch_gpu.as_ref().ok().map(|g| g.0),
+            },
+        }),
         files: vec![("lobe_product.svg".into(), svg.into_bytes())],
     })
 }

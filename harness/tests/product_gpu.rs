@@ -1,0 +1,218 @@
+//! The WGSL lobe product (`steradian_core::wgsl::LOBE_PRODUCT`) against the scalar kernel
+//! `product::product_with(ExactIntegral)`, lane by lane, within `wgsl::LOBE_PRODUCT_TOL`;
+//! and its naga validation (no device needed). The GPU tests skip with a message when no
+//! adapter is available unless `STERADIAN_REQUIRE_GPU=1`.
+
+use steradian_core::lobe::CosineLobe;
+use steradian_core::product::{self, ProductFit, ProductTable};
+use steradian_core::{Vec3, wgsl};
+use steradian_harness::backend::gpu::{Gpu, gpu_required, try_gpu};
+use steradian_harness::backend::gpu_product::{
+    ProductGpuTable, run_lobe_product_columns, run_lobe_product_gpu,
+};
+use steradian_harness::kernels::Columns;
+
+fn say(msg: &str) {
+    eprintln!("{msg}");
+}
+
+fn gpu() -> Option<Gpu> {
+    match try_gpu() {
+        Ok(g) => {
+            say(&format!("GPU tests ran on adapter: {}", g.adapter_info()));
+            Some(g)
+        }
+        Err(reason) => {
+            if gpu_required() {
+                panic!("STERADIAN_REQUIRE_GPU=1 but no GPU backend: {reason}");
+            }
+            say(&format!("GPU tests skipped: {reason}"));
+            None
+        }
+    }
+}
+
+/// The harness's deterministic generator, with the f32 helpers these tests want.
+struct Rng(steradian_harness::rng::Rng);
+
+impl Rng {
+    fn range(&mut self, lo: f32, hi: f32) -> f32 {
+        self.0.range(lo as f64, hi as f64) as f32
+    }
+    fn dir(&mut self) -> Vec3 {
+        Vec3::from(self.0.sphere().map(|x| x as f32)).normalize()
+    }
+    fn exponent(&mut self) -> f32 {
+        if self.0.next_u64().is_multiple_of(10) {
+            0.0
+        } else {
+            self.0.log_range(1e-3, 1e5) as f32
+        }
+    }
+    /// A pair of lobes `α` apart, `α` uniform in `[0, π)`.
+    fn pair(&mut self) -> (CosineLobe, CosineLobe) {
+        let a1 = self.dir();
+        let t = a1.any_orthonormal_vector();
+        let alpha = self.range(0.0, std::f32::consts::PI);
+        let a2 = (a1 * alpha.cos() + t * alpha.sin()).normalize();
+        let (s1, s2) = (self.range(0.1, 4.0), self.range(-2.0, 2.0));
+        (
+            CosineLobe::new(a1, s1, self.exponent()).unwrap(),
+            CosineLobe::new(a2, s2, self.exponent()).unwrap(),
+        )
+    }
+}
+
+#[test]
+fn lobe_product_wgsl_validates() {
+    let m = naga::front::wgsl::parse_str(wgsl::LOBE_PRODUCT).unwrap_or_else(|e| {
+        panic!(
+            "lobe-product: WGSL parse error:\n{}",
+            e.emit_to_string(wgsl::LOBE_PRODUCT)
+        )
+    });
+    naga::valid::Validator::new(
+        naga::valid::ValidationFlags::all(),
+        naga::valid::Capabilities::all(),
+    )
+    .validate(&m)
+    .unwrap_or_else(|e| {
+        panic!(
+            "lobe-product: WGSL validation error:\n{}",
+            e.emit_to_string(wgsl::LOBE_PRODUCT)
+        )
+    });
+    assert_eq!(m.entry_points.len(), 1);
+    assert_eq!(m.entry_points[0].name, "main");
+    assert_eq!(m.entry_points[0].workgroup_size, [64, 1, 1]);
+    let bindings: Vec<u32> = m
+        .global_variables
+        .iter()
+        .filter_map(|(_, g)| g.binding.as_ref().map(|b| b.binding))
+        .collect();
+    assert_eq!(bindings.len(), 4);
+    for b in 0..4 {
+        assert!(bindings.contains(&b), "binding {b}");
+    }
+}
+
+/// The differences of one lane divided by their bound's shape: `[axis, scale, exponent,
+/// integral]` (see `wgsl::LOBE_PRODUCT_TOL`).
+fn diff(a: &CosineLobe, b: &CosineLobe, got: &CosineLobe) -> [f64; 4] {
+    let want = product::product_with(&ProductTable::builtin(), ProductFit::ExactIntegral, a, b);
+    let axis = (got.axis() - want.axis()).abs().max_element() as f64;
+    let c = a.axis().dot(b.axis()).clamp(-1.0, 1.0);
+    let s = (b.axis() - a.axis() * c).length().min(1.0);
+    let ln_p = product::baseline(a.exponent(), b.exponent(), c, s).ln_peak as f64;
+    let ln_p = if ln_p.is_finite() { ln_p } else { 0.0 };
+    let (ws, we) = (want.scale() as f64, want.exponent() as f64);
+    let (gs, ge) = (got.scale() as f64, got.exponent() as f64);
+    let ln_i = ln_p + (std::f64::consts::TAU / (1.0 + we)).ln();
+    let l = 1.0 + ln_p.abs() + ln_i.abs();
+    let s12 = (a.scale() * b.scale()) as f64;
+    // Values below |s1·s2|·2⁻¹²⁶ may be flushed to zero.
+    let flush = s12.abs() * f32::MIN_POSITIVE as f64;
+    let rel = |d: f64, w: f64| {
+        if d <= flush { 0.0 } else { d / (l * w.abs()) }
+    };
+    let scale = rel((gs - ws).abs(), ws);
+    let exponent = (ge - we).abs() / (l * (1.0 + we));
+    let (gi, wi) = (gs / (1.0 + ge), ws / (1.0 + we));
+    let integral = rel((gi - wi).abs(), wi);
+    [axis, scale, exponent, integral]
+}
+
+fn run_and_check(g: &mut Gpu, pairs: &[(CosineLobe, CosineLobe)], what: &str) -> [f64; 4] {
+    let (a, b): (Vec<_>, Vec<_>) = pairs.iter().copied().unzip();
+    let got = run_lobe_product_gpu(g, &a, &b).expect("lobe product runs");
+    let tol = wgsl::LOBE_PRODUCT_TOL as f64;
+    let mut worst = [0.0f64; 4];
+    for (i, ((x, y), r)) in pairs.iter().zip(&got).enumerate() {
+        let d = diff(x, y, r);
+        assert!(
+            d.iter().all(|&v| v <= tol),
+            "{what} row {i}: {d:?} over {tol:e}: a={x:?} b={y:?} gpu={r:?} cpu={:?}",
+            product::product(x, y)
+        );
+        for (w, v) in worst.iter_mut().zip(d) {
+            *w = w.max(v);
+        }
+    }
+    worst
+}
+
+/// Random pairs over the whole domain (exponents `{0} ∪ [1e-3, 1e5]`, `α ∈ [0, π)`),
+/// lane by lane within `LOBE_PRODUCT_TOL`; prints the measured maxima.
+#[test]
+fn lobe_product_matches_scalar() {
+    let Some(mut g) = gpu() else { return };
+    let mut rng = Rng(steradian_harness::rng::Rng::new(0x9e0d_0001));
+    let pairs: Vec<_> = (0..100_000).map(|_| rng.pair()).collect();
+    let w = run_and_check(&mut g, &pairs, "random");
+    say(&format!(
+        "lobe-product GPU vs scalar: axis {:.2e} abs, scale {:.2e}, exponent {:.2e}, integral {:.2e} per unit of 1 + L",
+        w[0], w[1], w[2], w[3]
+    ));
+}
+
+/// Named hard cases: exponents 0, 1 and 1e5 in every combination at angles from 0 to just
+/// below π; coincident and exactly opposite axes (zero scale); e1 = e2 = 1e5 at α = 0.01;
+/// the paper's worst region (exponents below 1, α near π/2).
+#[test]
+fn lobe_product_hard_cases() {
+    let Some(mut g) = gpu() else { return };
+    let mut pairs = vec![];
+    let lobe = |a: Vec3, s: f32, e: f32| CosineLobe::new(a, s, e).unwrap();
+    let at = |alpha: f32| Vec3::new(alpha.sin(), 0.0, alpha.cos());
+    for e1 in [0.0, 1.0, 1e5] {
+        for e2 in [0.0, 1.0, 1e5] {
+            let pi = std::f32::consts::PI;
+            for alpha in [
+                0.0f32,
+                1e-4,
+                0.01,
+                0.5,
+                pi / 2.0,
+                2.5,
+                pi - 1.6e-3,
+                pi - 1e-4,
+            ] {
+                pairs.push((lobe(Vec3::Z, 1.0, e1), lobe(at(alpha), 1.0, e2)));
+            }
+            pairs.push((lobe(Vec3::Z, 2.0, e1), lobe(-Vec3::Z, 1.0, e2)));
+            pairs.push((lobe(Vec3::X, 2.0, e1), lobe(Vec3::X, 0.5, e2)));
+        }
+    }
+    pairs.push((lobe(Vec3::Z, 1.0, 1e5), lobe(at(0.01), 1.0, 1e5)));
+    let mut rng = Rng(steradian_harness::rng::Rng::new(7));
+    for _ in 0..1000 {
+        let (e1, e2, al) = (
+            rng.range(0.0, 1.0),
+            rng.range(0.0, 1.0),
+            rng.range(1.4, 1.75),
+        );
+        pairs.push((lobe(Vec3::Z, 1.0, e1), lobe(at(al), 1.0, e2)));
+    }
+    run_and_check(&mut g, &pairs, "hard cases");
+    // Exactly opposite axes give a zero-scale lobe, as on the CPU.
+    let got = run_lobe_product_gpu(
+        &mut g,
+        &[lobe(Vec3::Z, 2.0, 3.0)],
+        &[lobe(-Vec3::Z, 1.0, 5.0)],
+    )
+    .unwrap();
+    assert_eq!(got[0].scale(), 0.0);
+}
+
+/// Shape errors are reported, not panics; a table from other bytes is rejected.
+#[test]
+fn lobe_product_bad_shapes() {
+    assert!(ProductGpuTable::from_bytes(&[1, 2, 3]).is_err());
+    let Some(mut g) = gpu() else { return };
+    let t = ProductGpuTable::builtin().unwrap();
+    let input = Columns::zeros(9, 4);
+    let mut out = Columns::zeros(5, 4);
+    assert!(run_lobe_product_columns(&mut g, &t, &input, &mut out).is_err());
+    let l = CosineLobe::new(Vec3::Z, 1.0, 1.0).unwrap();
+    assert!(run_lobe_product_gpu(&mut g, &[l, l], &[l]).is_err());
+}

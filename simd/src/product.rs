@@ -1,0 +1,511 @@
+//! Products of two cosine lobes as one lobe, 8 (or 16) lanes at a time (mirrors
+//! `steradian_core::product`; see it for the formulas, their source in the cosine-lobe
+//! paper, section 4.1, and the table).
+//!
+//! Lane `k` of [`product_x8`] is `steradian_core::product::product_with(table, fit, a_k,
+//! b_k)` with `a_k`, `b_k` lane `k` of the inputs as [`LobeX8::to_array`] builds them
+//! (`CosineLobe::saturating`: the axis normalised, a zero axis replaced by `+z`, a negative
+//! exponent clamped to 0). The kernel performs the scalar kernel's operations in the same
+//! order; only the transcendental functions differ (wide's polynomial `ln`, `ln_1p`,
+//! `exp`, `exp_m1` and `atan2` instead of the standard library's; `ln` extended to
+//! subnormal arguments, `exp` to subnormal results), so:
+//!
+//! - the **axis** comes from correctly rounded operations only (the arc frame, the peak's
+//!   `(cos t*, sin t*)`, the final normalisation): it is **bit-identical** to the scalar
+//!   kernel's;
+//! - the **scale**, **exponent** and **integral** `2π·s/(e_r + 1)` are exponentials of sums
+//!   of logarithms (`ln p`, a sum of `e·ln cos t` terms; `ln I`, the logit-Laplace baseline
+//!   plus the table's correction at slightly different coordinates). An absolute error `δ`
+//!   in a logarithm `y` is a relative error `δ` in `e^y`, and wide's functions are good to
+//!   a few ulps of `|y|`, so the bounds are relative per unit of
+//!   `1 + L`, `L = |ln p| + |ln I|` (`p` the peak value and `I` the integral of the product
+//!   of the unit lobes):
+//!   - `|Δs| ≤ `[`SCALE_REL_TOL`]`·(1 + L)·|s| + u`,
+//!   - `|Δe_r| ≤ `[`EXPONENT_REL_TOL`]`·(1 + L)·(1 + e_r)`,
+//!   - `|ΔI_r| ≤ `[`INTEGRAL_REL_TOL`]`·(1 + L)·|I_r| + u/(1 + e_r)`, `I_r = s/(1 + e_r)`,
+//!
+//!   where `u = `[`UNDERFLOW_ABS`]`·(1 + |s1·s2|)` (times `max(1, (1 + e_r)/2π)` for
+//!   `ExactIntegralCurvature`, whose scale is `exp(ln I)·(1 + e_r)/2π`) matters only where a
+//!   subnormal intermediate is rounded onto the subnormal grid on both sides. Where `|ln I|
+//!   < 20` the measured relative integral difference is below `6e-6`, far below the table's
+//!   own error against the exact integral (`steradian_core::product::INTEGRAL_REL_MEAN`);
+//!   a result within the tolerance of `f32::MAX` may overflow to `±∞` on one side only.
+//!
+//! **Lanes recomputed by the scalar kernel** (bit-identical): a lane with a non-finite
+//! field (NaN or ±∞ in an axis component, scale or exponent), an exponent above
+//! [`MAX_WIDE_EXPONENT`] (ten times the table's range, where `f32` logarithms of the size
+//! `e·ln cos t` lose all digits in either kernel), or axes within about `1e-18` of opposite
+//! (the scalar kernel's `α = π` branch and its neighbourhood, where the baseline's
+//! half-angles underflow). So NaN and infinities give exactly what the scalar kernel gives:
+//! scales multiply (a NaN scale gives a NaN scale), a NaN exponent gives a NaN scale and
+//! exponent, a non-finite axis component gives a NaN axis. Lanes whose `s1·s2` overflows,
+//! and curvature-fit lanes whose peak sits on an `e < 1` lobe's horizon, go to the scalar
+//! kernel too. Such lanes are rare in rendering
+//! (exactly opposite axes are the common one) and cost one scalar call each.
+//!
+//! Table lookups are scalar loads per lane (wide has no gather); the trilinear arithmetic is
+//! vectorised in the scalar kernel's order.
+//!
+//! **Measured** (`tests/product.rs`, `survey_max_differences_long`, 2·10⁶ lanes per fit,
+//! exponents `{0} ∪ [1e-3, 1e5]` log-uniform, angles uniform in `[0, π)`, scales in
+//! `±[0.1, 10]`; the named cases and arbitrary bit patterns stay within the same bounds):
+//! per unit of `1 + L`, scale `5.9e-7`, exponent `4.6e-7`, integral `5.9e-7`
+//! (`ExactIntegralCurvature` has the largest scale and integral difference, its exponent is
+//! bit-identical). **Speed** (`cargo bench -p steradian-benches --bench product`, AVX-512
+//! build, 2-core shared machine): the slice function runs 33.8 M products/s against 3.8 M/s
+//! for the scalar kernel in the same run (8.9×), [`product_x8`] 23.8 M/s (6.2×); the
+//! spherical-Gaussian fit 51.5 M/s against 5.8 M/s.
+
+use core::f32::consts::TAU;
+
+use steradian_core::lobe::CosineLobe;
+use steradian_core::product::{
+    ANGLE_LOG_DROP, EXPONENT_EPS, ProductFit, ProductTable, product_with,
+};
+
+use crate::batch::{LobeX8, Vec3x8};
+use crate::lanes::{ColumnKernel, Lanes, SliceVec, clamp, drive, max_num, min_num};
+
+/// Bound on the scale's difference from the scalar kernel, relative, per unit of `1 + L`
+/// (see the module docs). Measured: `5.9e-7`.
+pub const SCALE_REL_TOL: f32 = 2.0e-6;
+/// Bound on the exponent's difference from the scalar kernel, relative to `1 + e_r`, per
+/// unit of `1 + L` (see the module docs). Measured: `4.6e-7`.
+pub const EXPONENT_REL_TOL: f32 = 2.0e-6;
+/// Bound on the difference of the result's integral `2π·s/(e_r + 1)` from the scalar
+/// kernel's, relative, per unit of `1 + L` (see the module docs). Measured: `5.9e-7`.
+pub const INTEGRAL_REL_TOL: f32 = 2.0e-6;
+/// Absolute allowance on the scale, per unit of `1 + |s1·s2|`, where an intermediate
+/// underflows into subnormals: two subnormal units (see the module docs).
+pub const UNDERFLOW_ABS: f32 = 2.0 * f32::from_bits(1);
+/// Exponents above this (and NaN, ±∞) are handed to the scalar kernel (see the module
+/// docs): below it every intermediate of the baseline stays finite.
+pub const MAX_WIDE_EXPONENT: f32 = 1.0e6;
+/// Lanes whose `sin 2x` or `sin 2y` (the doubled angles from the lobes' horizons to the
+/// baseline's peak, `x + y = π − α`) is below this are handed to the scalar kernel: the
+/// products `x·y` and `x²` of the baseline would be subnormal.
+const MIN_WIDE_SIN: f32 = 1.0e-18;
+
+/// `1/ln(1 + E/ε)` of `steradian_core::product::exponent_coord` (the same literal).
+const INV_LN_SPAN: f32 = 1.0 / 14.508_658;
+
+/// `ln x` for `x ≥ 0` including subnormals (wide's `ln` returns `−∞` for them): those are
+/// scaled by `2²⁴` first (exact) and `24·ln 2` subtracted.
+#[inline(always)]
+fn ln_full<W: Lanes>(x: W) -> W {
+    let tiny = x.lt(W::splat(f32::MIN_POSITIVE));
+    let xs = tiny.select(x * W::splat(16_777_216.0), x);
+    xs.ln() - tiny.select(W::splat(24.0 * core::f32::consts::LN_2), W::splat(0.0))
+}
+
+/// `exp(y)` with gradual underflow (wide's `exp` flushes below about `e^−103.6`): where the
+/// result may be subnormal (`y < −87`) it is `exp(y/2)²`, rounded once onto the subnormal
+/// grid; `y < −104` gives 0 (as the correctly rounded `exp` does below `−103.97`).
+#[inline(always)]
+fn exp_gradual<W: Lanes>(y: W) -> W {
+    let zero = W::splat(0.0);
+    let low = y.lt(W::splat(-87.0));
+    let dead = y.lt(W::splat(-104.0));
+    let arg = low.select(dead.select(zero, y * W::splat(0.5)), y);
+    let r = arg.exp();
+    dead.select(zero, low.select(r * r, r))
+}
+
+/// The scalar `one_pm_cos`: `(1 − cos φ, 1 + cos φ)` of `φ = atan2(sn, cs)`.
+#[inline(always)]
+fn one_pm_cos<W: Lanes>(sn: W, cs: W) -> (W, W) {
+    let (zero, one) = (W::splat(0.0), W::splat(1.0));
+    let h = (sn * sn + cs * cs).sqrt();
+    let s2 = sn * sn / h;
+    let (hp, hm) = (h + cs, h - cs);
+    let pos = cs.ge(zero);
+    let omc = pos.select(s2 / hp, hm / h);
+    let opc = pos.select(hp / h, s2 / hm);
+    let hz = h.eq(zero);
+    (hz.select(one, omc), hz.select(one, opc))
+}
+
+/// The scalar `peak_pair`.
+#[inline(always)]
+fn peak_pair<W: Lanes>(s: W, c: W, r: W, omr2: W, cy: W) -> (W, W) {
+    let zero = W::splat(0.0);
+    let rc = -r * c;
+    let den = cy + rc;
+    let sn_pos = den.gt(zero).select(s * omr2 / den, zero);
+    let sn = rc.ge(zero).select(sn_pos, s * (cy - rc));
+    let cs = c * cy - r * s * s;
+    (sn, cs)
+}
+
+/// The scalar `ratio`: `(r, 1 − r²)`.
+#[inline(always)]
+fn ratio<W: Lanes>(f1: W, f2: W) -> (W, W) {
+    let n = f1 + f2;
+    ((f2 - f1) / n, W::splat(4.0) * (f1 / n) * (f2 / n))
+}
+
+/// The scalar `ln_cos_half`: `½·log1p(−omc/2)` where `omc < opc`, else `½·ln(opc/2)`, with
+/// one `ln` per lane (wide's `ln_1p` is `ln(u)·x/(u − 1)`, `u = 1 + x`, spelled out here
+/// with the argument of the `ln` chosen per lane).
+#[inline(always)]
+fn ln_cos_half<W: Lanes>(omc: W, opc: W) -> W {
+    let (one, half) = (W::splat(1.0), W::splat(0.5));
+    let small = omc.lt(opc);
+    let x = W::splat(-0.5) * omc;
+    let u = x + one;
+    let l = ln_full(small.select(u, half * opc));
+    let log1p = u.eq(one).select(x, x * (l / (u - one)));
+    half * small.select(log1p, l)
+}
+
+/// The scalar `exponent_coord`.
+#[inline(always)]
+fn exponent_coord<W: Lanes>(e: W) -> W {
+    let u = (max_num(e, W::splat(0.0)) / W::splat(EXPONENT_EPS)).ln_1p() * W::splat(INV_LN_SPAN);
+    min_num(u, W::splat(1.0))
+}
+
+/// The closed-form part (scalar `baseline`) for finite lanes away from `α = π`: `(ln B, w,
+/// (cos t*, sin t*), ln p, arc curvature)`. `e1`, `e2` are already clamped to `≥ 0`.
+#[inline(always)]
+fn baseline<W: Lanes>(e1: W, e2: W, c: W, s: W) -> Baseline<W> {
+    let (zero, one, half) = (W::splat(0.0), W::splat(1.0), W::splat(0.5));
+    let two_pi = W::splat(TAU);
+    // The peak of the product (exponents e1, e2), for e1 + e2 > 0.
+    let (r, omr2) = ratio(e1, e2);
+    let cy = (c * c + omr2 * s * s).sqrt();
+    let (sn1, cs1) = peak_pair(s, c, r, omr2, cy);
+    let (sn2, cs2) = peak_pair(s, c, -r, omr2, cy);
+    let (omc1, opc1) = one_pm_cos(sn1, cs1);
+    let (omc2, opc2) = one_pm_cos(sn2, cs2);
+    let term = |e: W, omc: W, opc: W| e.eq(zero).select(zero, e * ln_cos_half(omc, opc));
+    let curv = |e: W, opc: W| e.eq(zero).select(zero, e * W::splat(2.0) / opc);
+    let peak_ln = term(e1, omc1, opc1) + term(e2, omc2, opc2);
+    let peak_curv = curv(e1, opc1) + curv(e2, opc2);
+    // Both exponents 0: the bisector (finite lanes only reach here, so no infinite sum).
+    let (omc0, opc0) = one_pm_cos(s, c);
+    let lune = (e1 + e2).gt(zero);
+    let peak_dir = (
+        (half * lune.select(opc1, opc0)).sqrt(),
+        (half * lune.select(omc1, omc0)).sqrt(),
+    );
+    let ln_peak = lune.select(peak_ln, zero);
+    let arc_curvature = lune.select(peak_curv, e1 + e2);
+
+    // Laplace in the logit variable around the peak of sin^(e1+1)·sin^(e2+1).
+    let (f1, f2) = (e1 + one, e2 + one);
+    let (r, omr2) = ratio(f1, f2);
+    let cy = (c * c + omr2 * s * s).sqrt();
+    let (snx, csx) = peak_pair(s, -c, -r, omr2, cy);
+    let (sny, csy) = peak_pair(s, -c, r, omr2, cy);
+    // Lanes near α = π go to the scalar kernel (see `MIN_WIDE_SIN`).
+    let redo = !(snx.ge(W::splat(MIN_WIDE_SIN)) & sny.ge(W::splat(MIN_WIDE_SIN)));
+    let x = half * snx.atan2(csx);
+    let y = half * sny.atan2(csy);
+    let (omcx, opcx) = one_pm_cos(snx, csx);
+    let (omcy, opcy) = one_pm_cos(sny, csy);
+    let ln_sin_x = ln_cos_half(opcx, omcx);
+    let ln_sin_y = ln_cos_half(opcy, omcy);
+    let w = clamp(
+        -(f1 * ln_sin_x + f2 * ln_sin_y) / W::splat(ANGLE_LOG_DROP),
+        zero,
+        one,
+    )
+    .sqrt();
+    let l = x + y;
+    let m = x * y / l;
+    let cot_x = (opcx / omcx).sqrt();
+    let cot_y = (opcy / omcy).sqrt();
+    let a = e1 * cot_x + one / x;
+    let b = e2 * cot_y + one / y;
+    let d = a - b;
+    let phi0 = e1 * ln_sin_x + e2 * ln_sin_y + ln_full(m);
+    let phi1 = d * m;
+    let ap = e1 * W::splat(2.0) / omcx + one / (x * x);
+    let bp = e2 * W::splat(2.0) / omcy + one / (y * y);
+    let h = max_num(m * m * (ap + bp) - d * (y - x) * m / l, W::splat(1e-30));
+    let n = e1 + e2;
+    let ln_k = half * ln_full(two_pi / (n + W::splat(1.5)));
+    let ln_b = ln_k + phi0 + phi1 * phi1 / (W::splat(2.0) * h) + half * ln_full(two_pi / h);
+    Baseline {
+        ln_b,
+        w,
+        peak_dir,
+        ln_peak,
+        arc_curvature,
+        redo,
+    }
+}
+
+struct Baseline<W> {
+    ln_b: W,
+    w: W,
+    peak_dir: (W, W),
+    ln_peak: W,
+    arc_curvature: W,
+    /// Lanes to recompute with the scalar kernel.
+    redo: W,
+}
+
+/// The scalar `ln_sg_integral`.
+#[inline(always)]
+fn ln_sg_integral<W: Lanes>(l1: W, l2: W, c: W, s: W) -> W {
+    let (zero, half) = (W::splat(0.0), W::splat(0.5));
+    let (omc, opc) = one_pm_cos(max_num(s, zero), c);
+    let (sh2, ch2) = (half * omc, half * opc);
+    let lr = ((l1 - l2) * (l1 - l2) + W::splat(4.0) * l1 * l2 * ch2).sqrt();
+    let den = lr + l1 + l2;
+    let ln_s = den
+        .gt(zero)
+        .select(W::splat(-4.0) * l1 * l2 * sh2 / den, zero);
+    let ln_int = W::splat(TAU.ln()) + ln_full(-(W::splat(-2.0) * lr).exp_m1()) - ln_full(lr);
+    ln_s + lr.eq(zero).select(W::splat((2.0 * TAU).ln()), ln_int)
+}
+
+/// The scalar `ProductTable::correction` at `(u1, u2, w)`: cell indices per lane, the eight
+/// table values read with scalar loads, the trilinear arithmetic lane-wise in the scalar
+/// order. NaN coordinates give NaN.
+#[inline(always)]
+fn correction<W: Lanes>(table: &ProductTable<'_>, u1: W, u2: W, w: W) -> W {
+    let ne = table.exponents();
+    let na = table.angles();
+    let cell = |x: W, n: usize| {
+        let last = W::splat((n - 1) as f32);
+        let t = clamp(x * last, W::splat(0.0), last);
+        let i = min_num(t.trunc(), W::splat((n - 2) as f32));
+        (i, t - i)
+    };
+    let (i, fi) = cell(u1, ne);
+    let (j, fj) = cell(u2, ne);
+    let (k, fk) = cell(w, na);
+    let (il, jl, kl) = (i.lanes(), j.lanes(), k.lanes());
+    let mut g = [[0.0f32; 16]; 8];
+    for lane in 0..W::N {
+        // NaN lanes index 0 (`as` saturates); their result is replaced below.
+        let (i, j, k) = (il[lane] as usize, jl[lane] as usize, kl[lane] as usize);
+        let base = |a: usize, b: usize| {
+            let (lo, hi) = if a <= b { (a, b) } else { (b, a) };
+            (hi * (hi + 1) / 2 + lo) * na + k
+        };
+        for (c, (a, b)) in [(i, j), (i, j + 1), (i + 1, j), (i + 1, j + 1)]
+            .into_iter()
+            .enumerate()
+        {
+            let idx = base(a, b);
+            g[2 * c][lane] = table.value(idx);
+            g[2 * c + 1][lane] = table.value(idx + 1);
+        }
+    }
+    let at = |c: usize| {
+        let g0 = W::from_fn(|l| g[2 * c][l]);
+        let g1 = W::from_fn(|l| g[2 * c + 1][l]);
+        g0 + fk * (g1 - g0)
+    };
+    let (g00, g01, g10, g11) = (at(0), at(1), at(2), at(3));
+    let g0 = g00 + fj * (g01 - g00);
+    let g1 = g10 + fj * (g11 - g10);
+    let r = g0 + fi * (g1 - g0);
+    (u1.is_nan() | u2.is_nan() | w.is_nan()).select(W::splat(f32::NAN), r)
+}
+
+/// `steradian_core::frame::normalize_or_zero` followed by `CosineLobe::saturating`'s
+/// zero → `+z`, lane-wise (finite lanes).
+#[inline(always)]
+fn normalize<W: Lanes>(x: W, y: W, z: W) -> (W, W, W) {
+    let zero = W::splat(0.0);
+    let m = max_num(max_num(x.abs(), y.abs()), z.abs());
+    let k = min_num(W::splat(1.0) / m, W::splat(f32::MAX));
+    let (sx, sy, sz) = (x * k, y * k, z * k);
+    let inv = W::splat(1.0) / (sx * sx + sy * sy + sz * sz).sqrt();
+    let mz = m.eq(zero);
+    (
+        mz.select(zero, sx * inv),
+        mz.select(zero, sy * inv),
+        mz.select(W::splat(1.0), sz * inv),
+    )
+}
+
+/// The product lane-wise, outputs `[ax, ay, az, scale, exponent]`, and the mask of lanes
+/// to recompute with the scalar kernel.
+#[inline(always)]
+fn product_lanes<W: Lanes>(
+    table: &ProductTable<'_>,
+    fit: ProductFit,
+    [a1x, a1y, a1z, s1, e1, a2x, a2y, a2z, s2, e2]: [W; 10],
+) -> ([W; 5], W) {
+    let (zero, one) = (W::splat(0.0), W::splat(1.0));
+    let big = W::splat(MAX_WIDE_EXPONENT);
+    // Non-finite fields (x·0 is NaN exactly for NaN and ±∞), huge exponents.
+    let nonfinite = [a1x, a1y, a1z, s1, a2x, a2y, a2z, s2]
+        .into_iter()
+        .fold(zero, |acc, v| acc + v * zero)
+        .is_nan();
+    let redo_in = nonfinite | !(e1.le(big) & e2.le(big));
+    // `CosineLobe::saturating`: normalised axes, negative exponents → 0; then the kernel's
+    // own `max(0)` (a no-op on the finite lanes computed here).
+    let (a1x, a1y, a1z) = normalize(a1x, a1y, a1z);
+    let (a2x, a2y, a2z) = normalize(a2x, a2y, a2z);
+    let e1 = e1.lt(zero).select(zero, e1);
+    let e2 = e2.lt(zero).select(zero, e2);
+
+    // The scalar `arc_frame`.
+    let c = a1x * a2x + a1y * a2y + a1z * a2z;
+    let (px, py, pz) = (a2x - a1x * c, a2y - a1y * c, a2z - a1z * c);
+    let s = (px * px + py * py + pz * pz).sqrt();
+    // `Frame::from_unit_normal(a1).tangent()` where the axes are (anti)parallel.
+    let sign = a1z.ge(zero).select(one, W::splat(-1.0));
+    let fa = W::splat(-1.0) / (sign + a1z);
+    let fb = a1x * a1y * fa;
+    let (tx, ty, tz) = (one + sign * a1x * a1x * fa, sign * fb, -sign * a1x);
+    let apart = s.gt(W::splat(1e-30));
+    let (wx, wy, wz) = (
+        apart.select(px / s, tx),
+        apart.select(py / s, ty),
+        apart.select(pz / s, tz),
+    );
+    let c = clamp(c, W::splat(-1.0), one);
+    let s = min_num(s, one);
+
+    let base = baseline(e1, e2, c, s);
+    let ln_i = match fit {
+        ProductFit::ExactIntegral | ProductFit::ExactIntegralCurvature => {
+            base.ln_b + correction(table, exponent_coord(e1), exponent_coord(e2), base.w)
+        }
+        ProductFit::SphericalGaussian => ln_sg_integral(e1, e2, c, s),
+    };
+    let (ct, st) = base.peak_dir;
+    let (ax, ay, az) = normalize(a1x * ct + wx * st, a1y * ct + wy * st, a1z * ct + wz * st);
+    let scale = s1 * s2;
+    // s1·s2 overflowing (the scalar kernel then multiplies in another order).
+    let redo_in = redo_in | (scale * zero).is_nan();
+    let (out_scale, e_r, redo_in) = if fit == ProductFit::ExactIntegralCurvature {
+        let e_r = ((e1 + e2) * base.arc_curvature).sqrt();
+        let p = exp_gradual(ln_i + ln_full((e_r + one) * W::splat(1.0 / TAU)));
+        // An infinite curvature (peak on an e < 1 lobe's horizon): the scalar kernel
+        // falls back to the peak-matched exponent.
+        (scale * p, e_r, redo_in | (e_r * zero).is_nan())
+    } else {
+        let e_r = (W::splat(TAU.ln()) + base.ln_peak - ln_i).exp() - one;
+        (scale * exp_gradual(base.ln_peak), max_num(e_r, zero), redo_in)
+    };
+    // Scalar: `ln I = −∞` (the baseline's `h` overflowed, or `α = π`, which the scalar
+    // fallback handles) gives a zero-scale lobe of exponent 0.
+    let none = ln_i.eq(W::splat(f32::NEG_INFINITY));
+    let out_scale = none.select(zero * scale, out_scale);
+    let e_r = none.select(zero, e_r.lt(zero).select(zero, e_r));
+    ([ax, ay, az, out_scale, e_r], redo_in | base.redo)
+}
+
+/// Lane `k` of `r`, or the scalar kernel on lane `k` of the inputs (`input(column, k)`)
+/// where `mask` is set. Out of line and cold.
+#[cold]
+#[inline(never)]
+fn scalar_lanes<W: Lanes>(
+    table: &ProductTable<'_>,
+    fit: ProductFit,
+    input: impl Fn(usize, usize) -> f32,
+    mask: W,
+    r: [W; 5],
+) -> [W; 5] {
+    let mk = mask.lanes();
+    let mut out: [[f32; 16]; 5] = [[0.0; 16]; 5];
+    for (o, v) in out.iter_mut().zip(r.iter()) {
+        o[..W::N].copy_from_slice(v.lanes());
+    }
+    for k in 0..W::N {
+        if mk[k].to_bits() != 0 {
+            let l = |i: usize| input(i, k);
+            let a = CosineLobe::saturating(glam::Vec3::new(l(0), l(1), l(2)), l(3), l(4));
+            let b = CosineLobe::saturating(glam::Vec3::new(l(5), l(6), l(7)), l(8), l(9));
+            let p = product_with(table, fit, &a, &b);
+            let ax = p.axis();
+            for (o, v) in out
+                .iter_mut()
+                .zip([ax.x, ax.y, ax.z, p.scale(), p.exponent()])
+            {
+                o[k] = v;
+            }
+        }
+    }
+    core::array::from_fn(|c| W::from_fn(|k| out[c][k]))
+}
+
+/// The product of lobes `a` and `b` lane by lane, with `table` and `fit`: lane `k` is
+/// `steradian_core::product::product_with(table, fit, a_k, b_k)` for the lobes of
+/// [`LobeX8::to_array`] — axis bit-identical, scale and exponent within the bounds of the
+/// module docs, non-finite or extreme lanes exactly (scalar kernel).
+#[inline]
+pub fn product_x8(table: &ProductTable<'_>, fit: ProductFit, a: &LobeX8, b: &LobeX8) -> LobeX8 {
+    let lanes = [
+        a.axis.x, a.axis.y, a.axis.z, a.scale, a.exponent, b.axis.x, b.axis.y, b.axis.z, b.scale,
+        b.exponent,
+    ];
+    let (mut r, redo) = product_lanes(table, fit, lanes);
+    if redo.any() {
+        r = scalar_lanes(table, fit, |i, k| lanes[i].as_array()[k], redo, r);
+    }
+    LobeX8::new(Vec3x8::new(r[0], r[1], r[2]), r[3], r[4])
+}
+
+struct ProductK<'a> {
+    table: ProductTable<'a>,
+    fit: ProductFit,
+}
+
+impl ColumnKernel<10, 5> for ProductK<'_> {
+    const PADS: [f32; 10] = [
+        LobeX8::PAD_AXIS.x,
+        LobeX8::PAD_AXIS.y,
+        LobeX8::PAD_AXIS.z,
+        LobeX8::PAD_SCALE,
+        LobeX8::PAD_EXPONENT,
+        LobeX8::PAD_AXIS.x,
+        LobeX8::PAD_AXIS.y,
+        LobeX8::PAD_AXIS.z,
+        LobeX8::PAD_SCALE,
+        LobeX8::PAD_EXPONENT,
+    ];
+    #[inline(always)]
+    fn apply<W: Lanes>(&self, v: [W; 10]) -> ([W; 5], W) {
+        product_lanes(&self.table, self.fit, v)
+    }
+    fn redo<W: Lanes>(&self, ins: [&[f32]; 10], offset: usize, mask: W, r: [W; 5]) -> [W; 5] {
+        // Masked lanes lie inside the columns; elsewhere the value is unused.
+        let input = |col: usize, k: usize| ins[col].get(offset + k).copied().unwrap_or(0.0);
+        scalar_lanes(&self.table, self.fit, input, mask, r)
+    }
+}
+
+/// [`product_x8`] over structure-of-arrays columns: lobe `i` of `a` is
+/// `(a_axis[0][i], a_axis[1][i], a_axis[2][i])`, `a_scale[i]`, `a_exponent[i]`, likewise
+/// `b`, and the product goes to `out_axis`, `out_scale`, `out_exponent`. Any length (the
+/// tail is padded with the padding lobe of [`LobeX8`]); runs on the build's widest vector
+/// (16 lanes with AVX-512F, else 8), same results.
+///
+/// # Panics
+/// If the fifteen columns do not all have the same length.
+#[allow(clippy::too_many_arguments)]
+pub fn product_slices(
+    table: &ProductTable<'_>,
+    fit: ProductFit,
+    a_axis: [&[f32]; 3],
+    a_scale: &[f32],
+    a_exponent: &[f32],
+    b_axis: [&[f32]; 3],
+    b_scale: &[f32],
+    b_exponent: &[f32],
+    out_axis: [&mut [f32]; 3],
+    out_scale: &mut [f32],
+    out_exponent: &mut [f32],
+) {
+    let [ox, oy, oz] = out_axis;
+    drive::<SliceVec, _, 10, 5>(
+        "product::product_slices",
+        &ProductK { table: *table, fit },
+        [
+            a_axis[0], a_axis[1], a_axis[2], a_scale, a_exponent, b_axis[0], b_axis[1], b_axis[2],
+            b_scale, b_exponent,
+        ],
+        [ox, oy, oz, out_scale, out_exponent],
+    );
+}
