@@ -722,7 +722,7 @@ fn sg_integral(lambda: f64) -> f64 {
 /// algebraic end point of an exponent below 1 limits it; ample for shape errors ≥ 1e−3).
 pub fn coplanar_triple(e1: f64, e2: f64, alpha: f64, e3: f64, beta: f64) -> f64 {
     let (lo, hi) = (alpha - FRAC_PI_2, FRAC_PI_2);
-    if !(lo < hi) {
+    if hi.is_nan() || lo.is_nan() || hi <= lo {
         return 0.0;
     }
     let lnf = |t: f64| {

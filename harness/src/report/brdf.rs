@@ -1,0 +1,352 @@
+//! Report section: BRDF summed-area tables (`steradian_core::brdf_sat`). Per BRDF model, the
+//! resolution [`BrdfSat::fit`] chose for a modest target, the bytes, the achieved error on
+//! its test set, the error on fresh queries against the `f64` reference, the fit (build)
+//! time, and the query throughput against the baseline measured in the same run: a 4×4
+//! Gauss–Legendre quadrature of `ρ cos θᵢ` over the same square (16 BRDF evaluations, what
+//! the table replaces), whose error on the same queries is shown too.
+
+use std::error::Error;
+use std::fmt::Write as _;
+use std::hint::black_box;
+use std::time::{Duration, Instant};
+
+use indicatif::{ProgressBar, ProgressStyle};
+use serde_json::json;
+use steradian_core::brdf::{BlinnPhong, Brdf, Ggx, Lambert, Phong, Ward};
+use steradian_core::brdf_sat::{BrdfSat, FitOptions};
+use steradian_core::{Vec2, Vec3, hemisphere};
+
+use super::Options;
+use super::sections::Section;
+use crate::reference::brdf::{self as rb, Model};
+use crate::rng::Rng;
+
+/// Target error of every model's fit (module docs of `brdf_sat` for the metric).
+pub const TARGET: f32 = 0.05;
+/// Smallest square half-diagonal the report's "scene" needs.
+pub const R_MIN: f32 = 0.1;
+/// Largest half-diagonal.
+pub const R_MAX: f32 = 0.5;
+/// Largest view angle tabulated (degrees).
+pub const THETA_MAX_DEG: f32 = 80.0;
+/// Largest view angle tabulated for anisotropic BRDFs (degrees).
+pub const ANISO_THETA_MAX_DEG: f32 = 60.0;
+/// Cap on each model's tables.
+pub const MAX_BYTES: usize = 16 << 20;
+/// Queries per timed run.
+const QUERIES: usize = 1 << 14;
+/// Fresh queries compared against the f64 reference per model.
+const CHECKED: usize = 60;
+/// Timed repeats (median).
+const REPEATS: usize = 5;
+
+/// One BRDF-SAT query.
+#[derive(Clone, Copy, Debug)]
+pub struct Query {
+    /// Local view direction.
+    pub wo: Vec3,
+    /// Square centre (disk units).
+    pub centre: Vec2,
+    /// Half-diagonal.
+    pub r: f32,
+}
+
+/// `n` queries: views up to `theta_max` at any azimuth (a new view every 4 queries); squares centred on the mirror
+/// direction, with an edge through it, or anywhere in the disk (a third each); half-diagonals
+/// log-uniform in `[r_min, r_max]`.
+pub fn queries(n: usize, r_min: f32, r_max: f32, theta_max: f32, seed: u64) -> Vec<Query> {
+    let mut rng = Rng::new(seed);
+    let smax = (1.0 - (theta_max as f64).cos()).sqrt();
+    let (mut s, mut phi) = (0.0, 0.0);
+    (0..n)
+        .map(|k| {
+            if k % 4 == 0 {
+                s = smax * rng.unit().sqrt();
+                phi = rng.range(0.0, std::f64::consts::TAU);
+            }
+            let wo = hemisphere::unmap(Vec2::new((s * phi.cos()) as f32, (s * phi.sin()) as f32));
+            let r = rng.log_range(r_min as f64, r_max as f64);
+            let h = r * std::f64::consts::FRAC_1_SQRT_2;
+            let pk = [-s * phi.cos(), -s * phi.sin()];
+            let c = match k % 3 {
+                0 => pk,
+                1 => [pk[0] + h, pk[1] + h * rng.range(-1.0, 1.0)],
+                _ => {
+                    let (rr, t) = (rng.unit().sqrt(), rng.range(0.0, std::f64::consts::TAU));
+                    [rr * t.cos(), rr * t.sin()]
+                }
+            };
+            Query {
+                wo,
+                centre: Vec2::new(c[0] as f32, c[1] as f32),
+                r: r as f32,
+            }
+        })
+        .collect()
+}
+
+/// The baseline: 4×4 Gauss–Legendre quadrature (f32) of `ρ cos θᵢ` over the square of
+/// centre `c` and half-diagonal `r`, turned by the view azimuth when `turn` (the
+/// isotropic table's square), zero outside the disk.
+pub fn gl4_square(b: &dyn Brdf, wo: Vec3, c: Vec2, r: f32, turn: bool) -> f32 {
+    const X: [f32; 4] = [-0.861_136_3, -0.339_981_05, 0.339_981_05, 0.861_136_3];
+    const W: [f32; 4] = [0.347_854_85, 0.652_145_15, 0.652_145_15, 0.347_854_85];
+    let h = r * std::f32::consts::FRAC_1_SQRT_2;
+    let (cs, sn) = if turn {
+        let p = hemisphere::map(wo);
+        let l = p.length();
+        if l > 0.0 {
+            (p.x / l, p.y / l)
+        } else {
+            (1.0, 0.0)
+        }
+    } else {
+        (1.0, 0.0)
+    };
+    let mut s = 0.0;
+    for (y, wy) in X.iter().zip(W) {
+        for (x, wx) in X.iter().zip(W) {
+            let (a, bb) = (x * h, y * h);
+            let p = Vec2::new(c.x + cs * a - sn * bb, c.y + sn * a + cs * bb);
+            if p.length_squared() < 1.0 {
+                s += wx * wy * b.eval(hemisphere::unmap(p), wo);
+            }
+        }
+    }
+    // weights sum to 2 per axis over [-1, 1]: area h², and dω = 2 du dv
+    2.0 * s * h * h
+}
+
+fn median(mut v: Vec<Duration>) -> Duration {
+    v.sort();
+    v[v.len() / 2]
+}
+
+fn time<F: FnMut() -> f32>(mut f: F) -> Duration {
+    let t: Vec<Duration> = (0..REPEATS)
+        .map(|_| {
+            let t0 = Instant::now();
+            black_box(f());
+            t0.elapsed()
+        })
+        .collect();
+    median(t)
+}
+
+/// The models of the section.
+pub fn models() -> Vec<(String, Box<dyn Brdf>, Model)> {
+    fn m<B: Brdf + Copy + 'static>(name: &str, b: B) -> (String, Box<dyn Brdf>, Model)
+    where
+        Model: From<B>,
+    {
+        (name.to_string(), Box::new(b), Model::from(b))
+    }
+    // Parameters are valid constants: the constructors cannot fail on them.
+    let ok = "valid BRDF parameters";
+    vec![
+        m("Lambert a=0.8", Lambert::new(0.8).expect(ok)),
+        m("Phong e=10", Phong::new(0.3, 0.6, 10.0).expect(ok)),
+        m("Phong e=100", Phong::new(0.3, 0.6, 100.0).expect(ok)),
+        m("Phong e=1000", Phong::new(0.0, 1.0, 1000.0).expect(ok)),
+        m(
+            "Blinn-Phong e=100",
+            BlinnPhong::new(0.3, 0.6, 100.0).expect(ok),
+        ),
+        m("Ward α=0.2", Ward::isotropic(0.3, 0.2, 0.2).expect(ok)),
+        m(
+            "Ward αx=0.15 αy=0.4",
+            Ward::anisotropic(0.3, 0.2, 0.15, 0.4).expect(ok),
+        ),
+        m("GGX α=0.3", Ggx::new(0.3, 0.04, 0.3).expect(ok)),
+        m("GGX α=1", Ggx::new(0.3, 0.9, 1.0).expect(ok)),
+    ]
+}
+
+/// The section.
+pub fn section(_opts: &Options) -> Result<Section, Box<dyn Error>> {
+    let models = models();
+    let bar = ProgressBar::new(models.len() as u64).with_style(
+        ProgressStyle::with_template("{spinner} [{elapsed_precise}] {bar:30} {pos}/{len} {msg}")
+            .unwrap_or_else(|_| ProgressStyle::default_bar()),
+    );
+    let theta_max = THETA_MAX_DEG.to_radians();
+    let iso_opts = FitOptions {
+        r_min: R_MIN,
+        r_max: R_MAX,
+        theta_max,
+        max_grid: 256,
+        max_polar: 65,
+        max_azimuth: 64,
+        max_bytes: MAX_BYTES,
+        ..FitOptions::new(TARGET)
+    };
+    // Anisotropic: views up to 60° (between azimuth nodes the mirror direction sweeps a
+    // long arc at grazing views; linear interpolation there needs many nodes).
+    let aniso_opts = FitOptions {
+        theta_max: ANISO_THETA_MAX_DEG.to_radians(),
+        ..iso_opts
+    };
+    let mut rows = Vec::new();
+    for (name, b, model) in &models {
+        bar.set_message(name.clone());
+        let t0 = Instant::now();
+        let opts = if b.is_isotropic() {
+            &iso_opts
+        } else {
+            &aniso_opts
+        };
+        let t = BrdfSat::fit(b.as_ref(), opts)?;
+        let fit_time = t0.elapsed();
+        let q = queries(QUERIES, R_MIN, R_MAX, opts.theta_max, 0x00b5_d5a7);
+        let fit = t
+            .fit_report()
+            .ok_or("BrdfSat::fit returned no fit report")?;
+        // fresh queries against the f64 reference: table and baseline errors
+        let (mut e_tab, mut e_gl, mut s_tab, mut s_gl) = (0.0f64, 0.0f64, 0.0f64, 0.0f64);
+        let (mut last_wo, mut albedo) = (Vec3::NAN, 0.0);
+        for x in q.iter().take(CHECKED) {
+            let wo = [x.wo.x as f64, x.wo.y as f64, x.wo.z as f64];
+            if x.wo != last_wo {
+                albedo = rb::albedo(model, wo, 1e-5);
+                last_wo = x.wo;
+            }
+            let pm = rb::map(wo);
+            let angle = if b.is_isotropic() {
+                pm[1].atan2(pm[0])
+            } else {
+                0.0
+            };
+            let r = x.r as f64;
+            let c = [x.centre.x as f64, x.centre.y as f64];
+            let exact = rb::square_integral(model, wo, c, r, angle, 1e-4 * albedo * r * r);
+            let et = rb::table_error(t.integral(x.wo, x.centre, x.r) as f64, exact, albedo, r);
+            let eg = rb::table_error(
+                gl4_square(b.as_ref(), x.wo, x.centre, x.r, b.is_isotropic()) as f64,
+                exact,
+                albedo,
+                r,
+            );
+            e_tab = e_tab.max(et);
+            e_gl = e_gl.max(eg);
+            s_tab += et * et;
+            s_gl += eg * eg;
+        }
+        let n = CHECKED as f64;
+        let t_tab = time(|| q.iter().map(|x| t.integral(x.wo, x.centre, x.r)).sum());
+        let t_gl = time(|| {
+            q.iter()
+                .map(|x| gl4_square(b.as_ref(), x.wo, x.centre, x.r, b.is_isotropic()))
+                .sum()
+        });
+        let res = t.resolution();
+        rows.push(json!({
+            "model": name,
+            "isotropic": b.is_isotropic(),
+            "theta_max_deg": opts.theta_max.to_degrees(),
+            "grid": res.grid,
+            "polar_views": res.polar,
+            "azimuth_views": res.azimuth,
+            "bytes": t.bytes(),
+            "target": fit.target,
+            "met": fit.met,
+            "fit_max_error": fit.max_error,
+            "fit_rms_error": fit.rms_error,
+            "fit_steps": fit.steps,
+            "fresh_max_error": e_tab,
+            "fresh_rms_error": (s_tab / n).sqrt(),
+            "gl4x4_max_error": e_gl,
+            "gl4x4_rms_error": (s_gl / n).sqrt(),
+            "fit_seconds": fit_time.as_secs_f64(),
+            "queries_per_s": QUERIES as f64 / t_tab.as_secs_f64(),
+            "gl4x4_queries_per_s": QUERIES as f64 / t_gl.as_secs_f64(),
+        }));
+        bar.inc(1);
+    }
+    bar.finish_and_clear();
+
+    let f = |r: &serde_json::Value, k: &str| r[k].as_f64().unwrap_or(f64::NAN);
+    let mut summary = format!(
+        "BRDF SATs (target {TARGET}, squares r {R_MIN}–{R_MAX}, views ≤ {THETA_MAX_DEG}° \
+         (anisotropic ≤ {ANISO_THETA_MAX_DEG}°), ≤ {} MiB per model; baseline: 4×4 Gauss–Legendre over the square, same run):\n",
+        MAX_BYTES >> 20
+    );
+    let mut html = format!(
+        "<p>Each model's tables are chosen by <code>BrdfSat::fit</code> for a target error of \
+         {TARGET} (error = |T − R| / max(R, albedo·4r²/2π), see <code>brdf_sat</code>) on squares of \
+         half-diagonal {R_MIN}–{R_MAX} (parametrisation units) and views up to {THETA_MAX_DEG}° (anisotropic: {ANISO_THETA_MAX_DEG}°), at most {} MiB of tables per model. \
+         “fit” errors are over the fit's own test set, “fresh” over {CHECKED} other queries \
+         against the f64 reference. Throughput over {QUERIES} queries, median of {REPEATS}; \
+         the baseline is a 4×4 Gauss–Legendre quadrature of ρ·cos over the same square \
+         (16 BRDF evaluations).</p><table><tr><th>model</th><th>grid</th><th>views</th>\
+         <th>MiB</th><th>fit max / rms</th><th>fresh max / rms</th><th>GL 4×4 max / rms</th>\
+         <th>fit s</th><th>M queries/s</th><th>× GL 4×4</th></tr>",
+        MAX_BYTES >> 20
+    );
+    for r in &rows {
+        let views = format!(
+            "{}×{}",
+            r["polar_views"].as_u64().unwrap_or(0),
+            r["azimuth_views"].as_u64().unwrap_or(0)
+        );
+        let ratio = f(r, "queries_per_s") / f(r, "gl4x4_queries_per_s");
+        let _ = writeln!(
+            summary,
+            "  {:<22} grid {:>4} views {:>6} {:>7.2} MiB fit max {:.4}{} fresh max {:.4} \
+             (GL4×4 {:.4}) fit {:.2} s, {:.1} M q/s = {:.1}× GL4×4",
+            r["model"].as_str().unwrap_or(""),
+            r["grid"].as_u64().unwrap_or(0),
+            views,
+            f(r, "bytes") / (1 << 20) as f64,
+            f(r, "fit_max_error"),
+            if r["met"].as_bool() == Some(true) {
+                ""
+            } else {
+                " (not met)"
+            },
+            f(r, "fresh_max_error"),
+            f(r, "gl4x4_max_error"),
+            f(r, "fit_seconds"),
+            f(r, "queries_per_s") / 1e6,
+            ratio
+        );
+        let _ = write!(
+            html,
+            "<tr><td>{}</td><td>{}</td><td>{views}</td><td>{:.2}</td><td>{:.4} / {:.4}{}</td>\
+             <td>{:.4} / {:.4}</td><td>{:.4} / {:.4}</td><td>{:.2}</td><td>{:.1}</td><td>{:.1}</td></tr>",
+            r["model"].as_str().unwrap_or(""),
+            r["grid"].as_u64().unwrap_or(0),
+            f(r, "bytes") / (1 << 20) as f64,
+            f(r, "fit_max_error"),
+            f(r, "fit_rms_error"),
+            if r["met"].as_bool() == Some(true) {
+                ""
+            } else {
+                " (not met)"
+            },
+            f(r, "fresh_max_error"),
+            f(r, "fresh_rms_error"),
+            f(r, "gl4x4_max_error"),
+            f(r, "gl4x4_rms_error"),
+            f(r, "fit_seconds"),
+            f(r, "queries_per_s") / 1e6,
+            ratio
+        );
+    }
+    html.push_str("</table>");
+    Ok(Section {
+        id: "brdf_sat",
+        title: "BRDF summed-area tables".into(),
+        summary,
+        html,
+        data: json!({
+            "target": TARGET,
+            "r_min": R_MIN,
+            "r_max": R_MAX,
+            "theta_max_deg": THETA_MAX_DEG,
+            "queries": QUERIES,
+            "checked": CHECKED,
+            "models": rows,
+        }),
+        files: Vec::new(),
+    })
+}
