@@ -145,6 +145,24 @@ fn sat(c: &mut Criterion) {
             black_box(&out);
         })
     });
+    g.bench_function("steradian integer cells", |b| {
+        b.iter(|| {
+            for (o, q) in out.iter_mut().zip(&d.boxes) {
+                *o = view.box_sum_cells(q[0], q[1], q[2], q[3]);
+            }
+            black_box(&out);
+        })
+    });
+    let icols: [Vec<f32>; 4] =
+        std::array::from_fn(|c| d.boxes.iter().map(|q| q[c] as f32).collect());
+    g.bench_function("steradian integer corners SIMD", |b| {
+        b.iter(|| {
+            steradian_simd::sat::box_sum_slices(
+                &view, &icols[0], &icols[1], &icols[2], &icols[3], &mut out,
+            );
+            black_box(&out);
+        })
+    });
     g.bench_function("summed-area f32", |b| {
         b.iter(|| {
             for (o, q) in out.iter_mut().zip(&d.boxes) {

@@ -68,9 +68,14 @@
 //! gives 0; `±∞` corners are clipped like any other), and returns NaN if any corner is NaN.
 //! The result is `±∞` only if the true integral overflows `f32`.
 //!
-//! **Cost.** A query reads 16 table entries (4 pairs of adjacent entries in each of 4 rows;
-//! fewer cache lines than that), does 27 `i64` subtractions, 9 conversions and 10 `f64`
-//! operations. The table takes 8 bytes per entry, `(width + 1)·(height + 1)` entries.
+//! **Cost.** A query with fractional corners reads 16 table entries (4 pairs of adjacent
+//! entries in each of 4 rows; fewer cache lines than that), does 27 `i64` subtractions, 9
+//! conversions and 10 `f64` operations (out of line). A query whose four corners are
+//! integers strictly inside the far edges is the four lookups of eq. 2, inlined: three
+//! exact `i64` operations, one conversion, one scaling, one rounding (the same bits as the
+//! general path); [`SatView::box_sum_cells`] is that query for `usize` corners, without
+//! the float-to-index work. The table takes 8 bytes per entry, `(width + 1)·(height + 1)`
+//! entries.
 
 use crate::math;
 use crate::{Error, Vec2};
@@ -162,7 +167,15 @@ pub fn axis(c0: f32, c1: f32, n: usize) -> (usize, f32, usize, f32) {
         if f > last { last } else { f }
     };
     let (i0, i1) = (floor_min(lo), floor_min(hi));
-    (i0 as usize, lo - i0, i1 as usize, hi - i1)
+    (index(i0), lo - i0, index(i1), hi - i1)
+}
+
+/// An exact integer `0 ≤ x < 2³²` in an `f32` as a `usize` (NaN gives 0, as `x as usize`
+/// would), branch-free: the low word of the `f64` `2⁵² + x`, which holds `x` exactly.
+/// (`x as usize` saturates, which costs compares and branches on every query.)
+#[inline(always)]
+fn index(x: f32) -> usize {
+    ((f64::from(x) + 4_503_599_627_370_496.0).to_bits() & 0xffff_ffff) as usize
 }
 
 /// A summed-area table borrowed from stored slices: the query side of [`Sat`], and what a
@@ -173,6 +186,8 @@ pub struct SatView<'a> {
     width: usize,
     height: usize,
     exponent: i32,
+    /// The quantum `2^exponent` (kept so that a query does not rebuild it).
+    scale: f64,
     sums: &'a [i64],
 }
 
@@ -224,6 +239,7 @@ impl<'a> SatView<'a> {
             width,
             height,
             exponent,
+            scale: pow2(exponent),
             sums,
         })
     }
@@ -272,6 +288,7 @@ impl<'a> SatView<'a> {
             width,
             height,
             exponent,
+            scale: pow2(exponent),
             sums,
         })
     }
@@ -297,7 +314,7 @@ impl<'a> SatView<'a> {
     /// The quantum `2^e` as an `f64`.
     #[inline]
     pub fn quantum(&self) -> f64 {
-        pow2(self.exponent)
+        self.scale
     }
 
     /// The entries `S(k, l)` at `l·(width + 1) + k`, in quanta.
@@ -315,7 +332,7 @@ impl<'a> SatView<'a> {
     /// The integral over the box spanned by the corners `(u0, v0)` and `(u1, v1)` (texel
     /// units, any order), clipped to the table, rounded once to `f32`. Within the bound of
     /// the module docs; NaN if a corner is NaN.
-    #[inline]
+    #[inline(always)]
     pub fn box_sum(&self, u0: f32, v0: f32, u1: f32, v1: f32) -> f32 {
         (self.box_sum_f64(u0, v0, u1, v1)) as f32
     }
@@ -323,18 +340,32 @@ impl<'a> SatView<'a> {
     /// [`SatView::box_sum`] before its final rounding to `f32` (for callers that combine
     /// several box sums, e.g. interpolate between tables, before rounding). Within
     /// `2⁻⁴⁶·A + n·2⁻⁵⁹·T` of the exact integral (module docs); NaN if a corner is NaN.
-    #[inline]
+    #[inline(always)]
     pub fn box_sum_f64(&self, u0: f32, v0: f32, u1: f32, v1: f32) -> f64 {
+        // No NaN test up front: a NaN corner flows through `axis` without harm (its
+        // index becomes 0) and makes its fraction NaN, so it never takes the integer path.
+        let (i0, a0, i1, a1) = axis(u0, u1, self.width);
+        let (j0, b0, j1, b1) = axis(v0, v1, self.height);
+        // The fractions are `+0` or positive (`x − ⌊x⌋` is never `−0`), or NaN: all four
+        // are zero exactly when their bits are.
+        if (a0.to_bits() | a1.to_bits() | b0.to_bits() | b1.to_bits()) == 0 {
+            // Integer corners: the four lookups of eq. 2. `combine` would give the same
+            // bits (every other term has weight 0; see `BoxTerms::combine`).
+            return self.integer_box(i0, i1, j0, j1) as f64 * self.scale;
+        }
+        self.fractional_box(u0, v0, u1, v1)
+    }
+
+    /// The rest of [`SatView::box_sum_f64`]: fractional (or NaN) corners, the nine-term
+    /// combination. Kept out of line (it repeats the two `axis` calls rather than take
+    /// their results through memory) so that the integer path inlines into callers' loops.
+    #[inline(never)]
+    fn fractional_box(&self, u0: f32, v0: f32, u1: f32, v1: f32) -> f64 {
         if u0.is_nan() || v0.is_nan() || u1.is_nan() || v1.is_nan() {
             return f64::NAN;
         }
         let (i0, a0, i1, a1) = axis(u0, u1, self.width);
         let (j0, b0, j1, b1) = axis(v0, v1, self.height);
-        if a0 == 0.0 && a1 == 0.0 && b0 == 0.0 && b1 == 0.0 {
-            // Integer corners: the four lookups of eq. 2. `combine` would give the same
-            // bits (every other term has weight 0; see `BoxTerms::combine`).
-            return self.integer_box(i0, i1, j0, j1) as f64 * self.quantum();
-        }
         let t = BoxTerms {
             k: self.integer_terms((i0, i1), (j0, j1), (b0, b1)),
             a0,
@@ -342,17 +373,58 @@ impl<'a> SatView<'a> {
             b0,
             b1,
         };
-        t.combine() * self.quantum()
+        t.combine() * self.scale
     }
 
-    /// `S(I1,J1) − S(I0,J1) − S(I1,J0) + S(I0,J0)`, exact (wrapping) `i64`.
+    /// The integral over the box between the integer corners `(x0, y0)` and `(x1, y1)`
+    /// (texel units, any order, clipped to the table): the integer-coordinate query the
+    /// other summed-area-table crates offer. The same bits as
+    /// `box_sum(x0 as f32, y0 as f32, x1 as f32, y1 as f32)` for every input, at the cost
+    /// of a plain four-lookup query (no float-to-index work): the exact `i64` box sum,
+    /// rounded once. A box reaching the last column or row (`x = width` or `y = height`)
+    /// takes [`SatView::box_sum`]'s general path, as that query does (its result can
+    /// differ from the exact integer sum by the `f64` rounding of the bound).
     #[inline(always)]
-    fn integer_box(&self, i0: usize, i1: usize, j0: usize, j1: usize) -> i64 {
-        let w1 = self.width + 1;
-        let at = |i: usize, j: usize| self.sums.get(j * w1 + i).copied().unwrap_or(0);
-        at(i1, j1)
-            .wrapping_sub(at(i0, j1))
-            .wrapping_sub(at(i1, j0).wrapping_sub(at(i0, j0)))
+    pub fn box_sum_cells(&self, x0: usize, y0: usize, x1: usize, y1: usize) -> f32 {
+        let (w, h) = (self.width, self.height);
+        let (xl, xh) = (x0.min(x1), x0.max(x1));
+        let (yl, yh) = (y0.min(y1), y0.max(y1));
+        if xh < w && yh < h {
+            // Inside the table (so `xl ≤ xh < w`, `yl ≤ yh < h`): four plain lookups.
+            let w1 = w + 1;
+            let (r0, r1) = (yl * w1, yh * w1);
+            let at = |k: usize| self.sums.get(k).copied();
+            match (at(r0 + xl), at(r0 + xh), at(r1 + xl), at(r1 + xh)) {
+                (Some(s00), Some(s10), Some(s01), Some(s11)) => {
+                    let s = s11.wrapping_sub(s01).wrapping_sub(s10.wrapping_sub(s00));
+                    (s as f64 * self.scale) as f32
+                }
+                // Only for a corrupt `SatView` (entries checked at construction).
+                _ => 0.0,
+            }
+        } else {
+            // Corners clipped to at most 2^24 (MAX_SIDE): exact in f32.
+            let (x0, x1, y0, y1) = (x0.min(w), x1.min(w), y0.min(h), y1.min(h));
+            self.fractional_box(x0 as f32, y0 as f32, x1 as f32, y1 as f32) as f32
+        }
+    }
+
+    /// `S(I1,J1) − S(I0,J1) − S(I1,J0) + S(I0,J0)` in quanta, exact (wrapping) `i64`, for
+    /// `I ≤ width`, `J ≤ height` (larger column indices are clamped, and a row past the
+    /// table reads as zeros: wrong sums, never a panic). One range check per row; the
+    /// column indices are then provably in it. (The per-lane reads of the SIMD kernel.)
+    #[inline(always)]
+    pub fn integer_box(&self, i0: usize, i1: usize, j0: usize, j1: usize) -> i64 {
+        let w = self.width;
+        let w1 = w + 1;
+        let (i0, i1) = (i0.min(w), i1.min(w));
+        let row = |l: usize| self.sums.get(l * w1..l * w1 + w1);
+        match (row(j0), row(j1)) {
+            (Some(r0), Some(r1)) => r1[i1]
+                .wrapping_sub(r1[i0])
+                .wrapping_sub(r0[i1].wrapping_sub(r0[i0])),
+            _ => 0,
+        }
     }
 
     /// The integral over the axis-aligned square with centre `c` and half-diagonal `r`
@@ -384,13 +456,15 @@ impl<'a> SatView<'a> {
         })
     }
 
-    /// The nine exact sub-box sums for columns `I0, I1` and rows `J0, J1`
-    /// (`I < width`, `J < height`; the caller guarantees it). Rows `J0 + 1` and `J1 + 1`
-    /// are read only where their weight `b0`, `b1` is non-zero (otherwise their terms are
-    /// 0, which changes no bit of the result: see `BoxTerms::combine`), so that an
-    /// integer-corner query reads two rows, as a plain four-lookup query does.
+    /// The nine exact sub-box sums `[[P, E1, E0]; 3]` of [`BoxTerms::k`] for columns
+    /// `I0, I1` and rows `J0, J1` as [`axis`] gives them (`I < width`, `J < height`;
+    /// larger column indices are clamped, and a row past the table reads as zeros: wrong
+    /// sums, never a panic). Rows `J0 + 1` and `J1 + 1` are read only where their weight
+    /// `b0`, `b1` is non-zero (otherwise their terms are 0, which changes no bit of the
+    /// result: see `BoxTerms::combine`), so that an integer-corner query reads two rows,
+    /// as a plain four-lookup query does. (The per-lane table reads of the SIMD kernel.)
     #[inline(always)]
-    fn integer_terms(
+    pub fn integer_terms(
         &self,
         (i0, i1): (usize, usize),
         (j0, j1): (usize, usize),
@@ -619,6 +693,7 @@ mod owned {
                 width: self.width,
                 height: self.height,
                 exponent: self.exponent,
+                scale: super::pow2(self.exponent),
                 sums: &self.sums,
             }
         }

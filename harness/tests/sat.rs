@@ -432,6 +432,127 @@ fn simd_matches_scalar_bit_for_bit() {
     }
 }
 
+/// Integer corners (the fast paths: the scalar four-lookup path, `box_sum_cells`, and the
+/// SIMD kernel's all-lanes-integer path): inside, on the far edges (which take the general
+/// path), outside, inverted, and mixed with NaN lanes and fractional lanes.
+#[test]
+fn integer_corner_fast_paths_match_the_general_query_bit_for_bit() {
+    let mut rng = Rng::new(0x1c0);
+    for (w, h) in [(1, 1), (1, 9), (9, 1), (17, 13), (64, 64), (300, 7)] {
+        let g = Grid::new(
+            w,
+            h,
+            (0..w * h)
+                .map(|_| texel_gen(rng.next_u64() as u8, &mut rng))
+                .collect(),
+        )
+        .unwrap();
+        let s = build(&g);
+        let v = s.view();
+        let t: f64 = g.texels.iter().map(|&x| (x as f64).abs()).sum();
+        let mut c = |n: usize| -> usize {
+            match rng.next_u64() % 16 {
+                0 => n,
+                1 => n + 1 + (rng.next_u64() % 5) as usize,
+                2 => usize::MAX,
+                3 => 0,
+                _ => (rng.next_u64() % (n as u64 + 1)) as usize,
+            }
+        };
+        let qs: Vec<[usize; 4]> = (0..2000).map(|_| [c(w), c(h), c(w), c(h)]).collect();
+        for q in &qs {
+            let f = q.map(|x| x as f32);
+            let want = v.box_sum(f[0], f[1], f[2], f[3]);
+            let got = v.box_sum_cells(q[0], q[1], q[2], q[3]);
+            assert!(same(got, want), "{w}×{h} cells {q:?}: {got} vs {want}");
+            check(&g, &s, t, f).unwrap();
+        }
+        // Batches of 8 all-integer lanes (the SIMD integer path), then batches where one
+        // lane is NaN or fractional (the general path) — every lane as the scalar query.
+        for spoil in [None, Some(f32::NAN), Some(0.5f32)] {
+            let fq: Vec<[f32; 4]> = qs
+                .iter()
+                .enumerate()
+                .map(|(k, q)| {
+                    let mut f = q.map(|x| x as f32);
+                    if let Some(x) = spoil.filter(|_| k % 8 == 3) {
+                        f[1] = if x.is_nan() { x } else { f[1] + x };
+                    }
+                    f
+                })
+                .collect();
+            let cols = Columns::from_rows(&fq);
+            let mut out = vec![0.0; fq.len()];
+            steradian_simd::sat::box_sum_slices(
+                &v,
+                cols.col(0),
+                cols.col(1),
+                cols.col(2),
+                cols.col(3),
+                &mut out,
+            );
+            for (k, f) in fq.iter().enumerate() {
+                let want = v.box_sum(f[0], f[1], f[2], f[3]);
+                assert!(
+                    same(out[k], want),
+                    "{w}×{h} SIMD lane {k} {f:?}: {} vs {want}",
+                    out[k]
+                );
+            }
+        }
+    }
+}
+
+/// Integer texels with integer corners: the fixed-point sum is exact, so the query is the
+/// correctly rounded exact sum (what the f32 tables of the other crates miss, bench
+/// `sat`), through the scalar, the integer-coordinate and the SIMD query.
+#[test]
+fn integer_boxes_of_integer_texels_are_correctly_rounded() {
+    let n = 512;
+    let mut rng = Rng::new(0xb17e);
+    let bytes: Vec<u64> = (0..n * n).map(|_| rng.next_u64() % 256).collect();
+    let texels: Vec<f32> = bytes.iter().map(|&b| b as f32).collect();
+    let s = Sat::build(n, n, &texels).unwrap();
+    let v = s.view();
+    let mut rows = vec![0u64; (n + 1) * (n + 1)];
+    for j in 0..n {
+        for i in 0..n {
+            rows[(j + 1) * (n + 1) + i + 1] =
+                bytes[j * n + i] + rows[j * (n + 1) + i + 1] + rows[(j + 1) * (n + 1) + i]
+                    - rows[j * (n + 1) + i];
+        }
+    }
+    let exact = |x0: usize, y0: usize, x1: usize, y1: usize| {
+        let at = |x: usize, y: usize| rows[y * (n + 1) + x];
+        (at(x1, y1) + at(x0, y0) - at(x0, y1) - at(x1, y0)) as f32
+    };
+    let qs: Vec<[usize; 4]> = (0..4000)
+        .map(|_| {
+            let mut a = |m: u64| (rng.next_u64() % m) as usize;
+            let (x0, y0) = (a(n as u64), a(n as u64));
+            let (x1, y1) = ((x0 + 1 + a(300)).min(n), (y0 + 1 + a(300)).min(n));
+            [x0, y0, x1, y1]
+        })
+        .collect();
+    let cols = Columns::from_rows(&qs.iter().map(|q| q.map(|x| x as f32)).collect::<Vec<_>>());
+    let mut out = vec![0.0; qs.len()];
+    steradian_simd::sat::box_sum_slices(
+        &v,
+        cols.col(0),
+        cols.col(1),
+        cols.col(2),
+        cols.col(3),
+        &mut out,
+    );
+    for (k, q) in qs.iter().enumerate() {
+        let want = exact(q[0], q[1], q[2], q[3]);
+        let f = q.map(|x| x as f32);
+        assert_eq!(v.box_sum(f[0], f[1], f[2], f[3]), want, "{q:?}");
+        assert_eq!(v.box_sum_cells(q[0], q[1], q[2], q[3]), want, "{q:?}");
+        assert_eq!(out[k], want, "SIMD {q:?}");
+    }
+}
+
 // ---- WGSL --------------------------------------------------------------------------------
 
 #[test]

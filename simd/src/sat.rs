@@ -40,17 +40,6 @@ fn indices(x: f32x8) -> [usize; 8] {
 }
 
 #[inline(always)]
-fn to_f64(x: i64x8) -> f64x8 {
-    x.round_float()
-}
-
-/// `(P + a1·E1) − a0·E0` lane-wise, as `BoxTerms::combine` does per row pair.
-#[inline(always)]
-fn x_term(p: i64x8, e1: i64x8, e0: i64x8, a0: f64x8, a1: f64x8) -> f64x8 {
-    (to_f64(p) + a1 * to_f64(e1)) - a0 * to_f64(e0)
-}
-
-#[inline(always)]
 fn widen(x: f32x8) -> f64x8 {
     f64x8::new(x.to_array().map(f64::from))
 }
@@ -70,42 +59,45 @@ pub fn box_sum(sat: &SatView<'_>, u0: f32x8, v0: f32x8, u1: f32x8, v1: f32x8) ->
     let (i0, a0, i1, a1) = axis(u0, u1, sat.width());
     let (j0, b0, j1, b1) = axis(v0, v1, sat.height());
     let (i0, i1, j0, j1) = (indices(i0), indices(i1), indices(j0), indices(j1));
-
-    // The sixteen entries per lane: rows (J0, J0+1, J1, J1+1) × columns (I0, I0+1, I1, I1+1).
-    let sums = sat.sums();
-    let w1 = sat.width() + 1;
-    // Rows J0 + 1 and J1 + 1 only where their weight is non-zero (as the scalar kernel:
-    // otherwise they repeat rows J0 and J1, so their terms are exactly 0).
-    let (bl0, bl1) = (b0.to_array(), b1.to_array());
-    let mut g = [[0i64; 8]; 16];
-    for k in 0..8 {
-        let j0p = if bl0[k] != 0.0 { j0[k] + 1 } else { j0[k] };
-        let j1p = if bl1[k] != 0.0 { j1[k] + 1 } else { j1[k] };
-        for (r, l) in [j0[k], j0p, j1[k], j1p].into_iter().enumerate() {
-            for (c, i) in [i0[k], i1[k]].into_iter().enumerate() {
-                let at = l * w1 + i;
-                let [x, y] = match sums.get(at..at + 2) {
-                    Some(&[x, y]) => [x, y],
-                    _ => [0, 0],
-                };
-                g[4 * r + 2 * c][k] = x;
-                g[4 * r + 2 * c + 1][k] = y;
+    let q = f64x8::splat(sat.quantum());
+    // The fractions are 0 or positive (never −0, never NaN here): a sum of them is 0
+    // exactly when all are.
+    let integer = (a0 + a1 + b0 + b1).simd_eq(zero).all();
+    let out = if integer {
+        // Every lane has integer corners: the scalar kernel's four-lookup path in every
+        // lane (the same `i64` box sum, conversion, scaling and rounding).
+        let (sums, w1) = (sat.sums(), sat.width() + 1);
+        let at = |k: usize| sums.get(k).copied().unwrap_or(0);
+        let s: [i64; 8] = core::array::from_fn(|k| {
+            let (r0, r1) = (j0[k] * w1, j1[k] * w1);
+            at(r1 + i1[k])
+                .wrapping_sub(at(r1 + i0[k]))
+                .wrapping_sub(at(r0 + i1[k]).wrapping_sub(at(r0 + i0[k])))
+        });
+        let r = (i64x8::new(s).round_float() * q).to_array();
+        f32x8::new(r.map(|v| v as f32))
+    } else {
+        // Per lane, the nine exact sub-box sums (the scalar kernel's own reads and integer
+        // differences), then the f64 combination in the scalar order, lane-wise (no fused
+        // multiply-add). Rows J + 1 are read only where their weight is non-zero, as in
+        // the scalar kernel.
+        let (bl0, bl1) = (b0.to_array(), b1.to_array());
+        let mut t = [[0i64; 8]; 9];
+        for k in 0..8 {
+            let kk = sat.integer_terms((i0[k], i1[k]), (j0[k], j1[k]), (bl0[k], bl1[k]));
+            for r in 0..3 {
+                for c in 0..3 {
+                    t[3 * r + c][k] = kk[r][c];
+                }
             }
         }
-    }
-    let row = |r: usize| -> [i64x8; 4] { core::array::from_fn(|c| i64x8::new(g[4 * r + c])) };
-    let (r0, r0p, r1, r1p) = (row(0), row(1), row(2), row(3));
-    let (a0, a1, b0, b1) = (widen(a0), widen(a1), widen(b0), widen(b1));
-    // [P, E1, E0] between rows l and m, combined: the scalar kernel's `d` then `x`.
-    let x = |l: [i64x8; 4], m: [i64x8; 4]| -> f64x8 {
-        let p = (m[2] - m[0]) - (l[2] - l[0]);
-        let e1 = (m[3] - m[2]) - (l[3] - l[2]);
-        let e0 = (m[1] - m[0]) - (l[1] - l[0]);
-        x_term(p, e1, e0, a0, a1)
+        let f = |n: usize| i64x8::new(t[n]).round_float();
+        let (a0, a1, b0, b1) = (widen(a0), widen(a1), widen(b0), widen(b1));
+        let x = |n: usize| (f(n) + a1 * f(n + 1)) - a0 * f(n + 2);
+        let (x_box, x_top, x_bottom) = (x(0), x(3), x(6));
+        let r = (((x_box + b1 * x_top) - b0 * x_bottom) * q).to_array();
+        f32x8::new(r.map(|v| v as f32))
     };
-    let (x_box, x_top, x_bottom) = (x(r0, r1), x(r1, r1p), x(r0, r0p));
-    let q = ((x_box + b1 * x_top) - b0 * x_bottom) * f64x8::splat(sat.quantum());
-    let out = f32x8::new(q.to_array().map(|v| v as f32));
     nan.select(f32x8::splat(f32::NAN), out)
 }
 
