@@ -29,18 +29,46 @@
 //!
 //! ## Merging (section 4.1.2, Figure 5)
 //!
-//! Every texel starts as a region; the pair of adjacent regions whose *merged* region has
-//! the least objective is merged, until `K` regions remain. Figure 5 rescans every region
-//! and its neighbours at each step (kept here as [`decompose_rescan`], the reference and
-//! the timing baseline); [`decompose`] keeps every candidate pair in a binary heap keyed by
-//! its merged objective and invalidates lazily: a merge creates a region with a new id,
-//! only pairs with the new region are fitted and pushed, and popped pairs whose regions no
-//! longer exist are skipped. Both select the same pair at each step (same key, same ties:
-//! `(objective, smallest texel of each region)`), so they give the same partition. One run
-//! yields every requested `K` (the partitions are nested). Measured on the 2-core dev
-//! machine (report section `rsl`): 6 × 32 × 32 down to `K = 10` in 0.4–0.9 s (the paper:
-//! about 2 minutes); on 6 × 8 × 8 the rescan is about 15× slower than the heap, and the gap
-//! grows with the square of the texel count.
+//! Every texel starts as a region; at each step the pair of adjacent regions with the least
+//! merge key is merged, until `K` regions remain. Figure 5 rescans every region and its
+//! neighbours at each step (kept here as [`decompose_rescan`], the reference and the timing
+//! baseline); [`decompose`] keeps every candidate pair in a binary heap and invalidates
+//! lazily: a merge creates a region with a new id, only pairs with the new region are
+//! fitted and pushed, and popped pairs whose regions no longer exist are skipped. A pair's
+//! key depends only on its two (immutable) regions, so both select the same pair at each
+//! step (same key, same ties: `(key, smallest texel of each region)`) and give the same
+//! partition. One run yields every requested `K` (the partitions are nested). Measured on
+//! the 2-core dev machine (report section `rsl`): 6 × 32 × 32 down to `K = 10` in
+//! 0.3–0.9 s (the paper: about 2 minutes); on 6 × 8 × 8 the rescan is about 15× slower than
+//! the heap, and the gap grows with the square of the texel count.
+//!
+//! ## Merge objectives ([`Options::objective`])
+//!
+//! - [`Objective::Paper`]: the key is the merged region's eq. 7 objective `|S|·mean_θ η²`
+//!   (the paper: "the merged subregion has the least RSL fitting error").
+//! - [`Objective::Bound`] (default): the key is the *increase* of the summed eq. 13 bound,
+//!   `B(a ∪ b) − B(a) − B(b)`, with
+//!
+//!   ```text
+//!   B(S) = E·σ̂_V·σ̂_ρ + w_L·sqrt(|S|·η̄²)·(σ̂_V + σ̂_ρ + σ̂_V·σ̂_ρ),
+//!   σ̂_V = ½·(|S|/1 sr)^¼,  σ̂_ρ = (|S|/1 sr)^½,  w_L = 30   ([`bound_cost`]).
+//!   ```
+//!
+//!   Why: the shading error of region `S` is the multi-product error of eq. 5, bounded by
+//!   eq. 13, `|S|·(u_L·σ_V·σ_ρ + u_V·σ_ρ·σ_L + u_ρ·σ_L·σ_V + m_L·m_V·m_ρ)`, plus the
+//!   error of replacing the region by its square (eq. 6). With `u_V, u_ρ` normalised to 1
+//!   and `σ_V, σ_ρ` replaced by the paper's own scaling laws (section 4.1.1 and 6.1:
+//!   `E(σ_V²) ∝ sqrt|S|`, and a smooth `ρ·cos` varying linearly across the region), the
+//!   first term is `E·σ̂_V·σ̂_ρ` — energy × angular extent — which eq. 7 ignores: eq. 7 is
+//!   `|S|²σ_L²` plus the square mismatch, zero for any uniform region however large, so the
+//!   paper's merge builds big uniform sky regions that straddle contact shadows and whose
+//!   `ρ` varies across them. The light terms use the RSL fit in place of `|S|·σ_L`
+//!   (`sqrt(|S|·η̄²) ≥ |S|·σ_L`, and it includes the square mismatch of eq. 6); the third
+//!   moments are modelled by the second (`m ≈ σ`). The bound is summed over regions, so the
+//!   greedy step takes the merge that raises the sum least (the merged value as key would
+//!   favour merging small dark regions with anything). `w_L` and the exponents are a
+//!   model, not a theorem: the report section `shade` measures both objectives per `K`
+//!   against the exact integral, with the true eq. 13 bound beside them.
 //!
 //! **Deviation, optional:** the paper merges only regions on the same cube face "for
 //! simplicity"; our fit works on the sphere, so merging across face edges is the default
@@ -83,6 +111,45 @@ pub struct Options {
     pub cross_face: bool,
     /// Show a progress bar when the run takes more than a second.
     pub progress: bool,
+    /// The merge objective (default [`Objective::Bound`]).
+    pub objective: Objective,
+}
+
+/// Which cost the merging minimises (module docs, "Merge objectives").
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub enum Objective {
+    /// The paper's eq. 7: `|S|·mean_θ η²(θ)` ([`Fit::objective`]).
+    Paper,
+    /// The eq. 13 bound with modelled BRDF and visibility deviations ([`Fit::bound`]).
+    #[default]
+    Bound,
+}
+
+/// `σ̂_V(|S|) = ½·(|S|/1 sr)^¼`: modelled standard deviation of visibility over a region
+/// (Agarwal et al.: `E(σ_V²) ∝ sqrt|S|`, saturating at ½ for a half-shadowed steradian).
+const SIGMA_V_SCALE: f64 = 0.5;
+/// `σ̂_ρ(|S|) = (|S|/1 sr)^½`: modelled relative standard deviation of `ρ·cos θ` over a
+/// region (a smooth BRDF varies linearly across it; not capped, so that a region of a
+/// hemisphere, which no square represents, is expensive).
+const SIGMA_RHO_SCALE: f64 = 1.0;
+/// Weight of the light-variance terms of eq. 13 against `u_L·σ_V·σ_ρ` (chosen by the
+/// measurement in the report section `shade`: the weights 10, 30 and 100 gave K = 30
+/// kernel errors of 1.03 / 0.73 / 0.85 % on the default sky, 0.68 / 0.59 / 0.55 % on
+/// `sky.exr`).
+const LIGHT_WEIGHT: f64 = 30.0;
+
+/// The eq. 13 merge cost of a region (module docs, "Merge objectives"):
+/// `E·σ̂_V·σ̂_ρ + w_L·sqrt(|S|·η̄²)·(σ̂_V + σ̂_ρ + σ̂_V·σ̂_ρ)` with `E = ∫_S L` (luminance),
+/// `η̄²` the rotation-averaged RSL fitting error ([`Fit::eta2`]) and `σ̂_V`, `σ̂_ρ` the
+/// modelled deviations of visibility and BRDF at solid angle `|S|` sr. Non-negative;
+/// non-finite or negative inputs are clamped to 0.
+pub fn bound_cost(solid_angle: f64, energy: f64, eta2: f64) -> f64 {
+    let pos = |x: f64| if x > 0.0 && x.is_finite() { x } else { 0.0 };
+    let s = pos(solid_angle);
+    let sv = SIGMA_V_SCALE * s.sqrt().sqrt();
+    let sr = SIGMA_RHO_SCALE * s.sqrt();
+    let sl = (s * pos(eta2)).sqrt();
+    pos(energy) * sv * sr + LIGHT_WEIGHT * sl * (sv + sr + sv * sr)
 }
 
 impl Default for Options {
@@ -91,6 +158,7 @@ impl Default for Options {
             ks: PAPER_KS.to_vec(),
             cross_face: true,
             progress: true,
+            objective: Objective::Bound,
         }
     }
 }
@@ -110,6 +178,8 @@ pub struct Fit {
     pub eta2: f64,
     /// The merge objective of eq. 7, `|S| · eta2`.
     pub objective: f64,
+    /// The eq. 13 merge objective ([`bound_cost`]).
+    pub bound: f64,
 }
 
 /// One region of a decomposition and its RSL.
@@ -155,6 +225,8 @@ pub struct Decomposition {
     pub seconds: f64,
     /// Whether merges crossed cube-face edges.
     pub cross_face: bool,
+    /// The merge objective that produced it.
+    pub merge: Objective,
 }
 
 impl Decomposition {
@@ -203,6 +275,11 @@ impl Decomposition {
     /// Sum of the objectives of eq. 7 over the regions.
     pub fn objective(&self) -> f64 {
         self.regions.iter().map(|r| r.fit.objective).sum()
+    }
+
+    /// Sum of the modelled eq. 13 costs ([`bound_cost`]) over the regions.
+    pub fn bound(&self) -> f64 {
+        self.regions.iter().map(|r| r.fit.bound).sum()
     }
 }
 
@@ -335,6 +412,7 @@ impl Fitter {
             solid_angle: 2.0 * rho * rho,
             eta2: f,
             objective: sums.s * f,
+            bound: bound_cost(sums.s, sums.e, f),
         }
     }
 
@@ -515,10 +593,13 @@ struct State<'a> {
     alive: Vec<bool>,
     n_alive: usize,
     fitter: Fitter,
+    objective: Objective,
+    /// Merge cost of every region alone (for the increase key).
+    cost: Vec<f64>,
 }
 
 impl<'a> State<'a> {
-    fn new(cube: &'a CubeMap, cross_face: bool) -> State<'a> {
+    fn new(cube: &'a CubeMap, cross_face: bool, objective: Objective) -> State<'a> {
         let n = cube.len();
         let per_face = cube.n() * cube.n();
         let mut adj = vec![BTreeSet::new(); n];
@@ -536,7 +617,7 @@ impl<'a> State<'a> {
                 adj[nb as usize].insert(k as u32);
             }
         }
-        State {
+        let mut st = State {
             td: Texels::new(cube),
             cube,
             texels: (0..n as u32).map(|k| vec![k]).collect(),
@@ -544,6 +625,21 @@ impl<'a> State<'a> {
             alive: vec![true; n],
             n_alive: n,
             fitter: Fitter::default(),
+            objective,
+            cost: Vec::with_capacity(2 * n),
+        };
+        for k in 0..n as u32 {
+            let fit = st.fitter.fit(&st.td, &[k], &[]);
+            let c = st.cost_of(&fit);
+            st.cost.push(c);
+        }
+        st
+    }
+
+    fn cost_of(&self, fit: &Fit) -> f64 {
+        match self.objective {
+            Objective::Paper => fit.objective,
+            Objective::Bound => fit.bound,
         }
     }
 
@@ -551,8 +647,13 @@ impl<'a> State<'a> {
         let (ta, tb) = (&self.texels[a as usize], &self.texels[b as usize]);
         let fit = self.fitter.fit(&self.td, ta, tb);
         let (ka, kb) = (ta[0], tb[0]);
+        let mut cost = self.cost_of(&fit);
+        if self.objective == Objective::Bound {
+            // The increase of the summed bound (module docs).
+            cost -= self.cost[a as usize] + self.cost[b as usize];
+        }
         Cand {
-            cost: fit.objective,
+            cost,
             key: (ka.min(kb), ka.max(kb)),
             a,
             b,
@@ -577,6 +678,9 @@ impl<'a> State<'a> {
             self.texels[id as usize] = Vec::new();
             self.adj[id as usize].clear();
         }
+        let fit = self.fitter.fit(&self.td, &t, &[]);
+        let c = self.cost_of(&fit);
+        self.cost.push(c);
         self.texels.push(t);
         self.adj.push(nbrs);
         self.alive.push(true);
@@ -618,6 +722,7 @@ impl<'a> State<'a> {
             region_of,
             seconds,
             cross_face,
+            merge: self.objective,
         }
     }
 }
@@ -662,7 +767,7 @@ fn progress_bar(total: u64, want: bool) -> ProgressBar {
 pub fn decompose(cube: &CubeMap, opts: &Options) -> Result<Vec<Decomposition>, EnvError> {
     let ks = check_ks(cube, &opts.ks, opts.cross_face)?;
     let start = Instant::now();
-    let mut st = State::new(cube, opts.cross_face);
+    let mut st = State::new(cube, opts.cross_face, opts.objective);
     let k_min = *ks.last().unwrap_or(&1);
     let bar = progress_bar((cube.len() - k_min) as u64, opts.progress);
     let mut shown = false;
@@ -719,10 +824,11 @@ pub fn decompose_rescan(
     cube: &CubeMap,
     k: usize,
     cross_face: bool,
+    objective: Objective,
 ) -> Result<Decomposition, EnvError> {
     let ks = check_ks(cube, &[k], cross_face)?;
     let start = Instant::now();
-    let mut st = State::new(cube, cross_face);
+    let mut st = State::new(cube, cross_face, objective);
     while st.n_alive > ks[0] {
         let mut best: Option<Cand> = None;
         for a in 0..st.texels.len() as u32 {

@@ -1,0 +1,807 @@
+//! RSL shading against the exact rendering integral (rotatable-square-lights paper, eq. 3–5,
+//! Figure 8, section 6, Figures 9–10).
+//!
+//! ## Scene
+//!
+//! [`Scene::standard`]: a ground plane (`z = 0`) with three occluder spheres resting on it,
+//! shading points on a grid over the ground and on the upper half of the largest sphere
+//! (the half that faces the viewer), one viewer. Points on a sphere are occluded by the
+//! other spheres (a sphere cannot shadow its own convex surface: its own horizon is the
+//! cosine's); ground points by all three.
+//!
+//! ## The exact reference
+//!
+//! `B(x, wₒ) = ∫ L(ω)·ρ(ω, wₒ)·cos θ·V(x, ω) dω` with `L` the cube map (piecewise constant per
+//! texel, exact texel solid angles), `ρ·cos` the BRDF model ([`steradian_core::brdf`],
+//! evaluated at `f32`, accumulated in `f64`) and `V` exact ray–sphere visibility (`f64`).
+//! Every texel of every face is summed; each texel is split into `sub × sub` sub-texels
+//! with exact solid angles and `ρ·V` is taken at their centres, so `sub = 1` is the sum over
+//! texel centres and larger `sub` converges to the exact integral of the piecewise-constant
+//! environment (the report and tests state the difference between `sub` levels).
+//!
+//! ## Factor analysis
+//!
+//! [`Analysis`] evaluates, per point and per decomposition, the RSL estimate with the
+//! approximate factors swapped for exact ones one at a time (see [`Variant`]), so the
+//! share of each approximation in the total error is measured rather than guessed:
+//! the multi-product approximation itself over the true regions (bounded by eq. 13, which
+//! is evaluated alongside), the square-for-region replacement of eq. 6, the BRDF SAT and the
+//! VDT.
+
+#![allow(clippy::needless_range_loop)] // RGB channels are indexed in parallel arrays
+
+use std::f64::consts::FRAC_1_SQRT_2;
+
+use glam::{DVec2, DVec3, Vec2, Vec3};
+use steradian_core::brdf::Brdf;
+use steradian_core::brdf_sat::{BrdfSat, FitOptions};
+use steradian_core::frame::Frame;
+use steradian_core::rsl::map_extended;
+use steradian_core::shade::{
+    self, BrdfIntegral, Moments, ShadeLight, VdtQuery, VdtVisibility, multi_product_bound,
+};
+use steradian_core::vdt::Vdt;
+use steradian_core::visibility::{Outside, binary_into, coverage_into, local_cap};
+
+use crate::env::cubemap::{FACES, rect_solid_angle};
+use crate::env::{CubeMap, Decomposition};
+
+/// A sphere (occluder).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Sphere {
+    /// Centre.
+    pub centre: DVec3,
+    /// Radius.
+    pub radius: f64,
+}
+
+impl Sphere {
+    /// Whether the ray `o + t·d`, `t > 0` (`d` unit, `o` outside the sphere) hits it.
+    #[inline]
+    pub fn blocks(&self, o: DVec3, d: DVec3) -> bool {
+        let oc = self.centre - o;
+        let b = oc.dot(d);
+        let c = oc.length_squared() - self.radius * self.radius;
+        b > 0.0 && b * b >= c
+    }
+}
+
+/// One shading point.
+#[derive(Clone, Debug)]
+pub struct ShadePoint {
+    /// Position.
+    pub pos: DVec3,
+    /// The local frame (normal = z).
+    pub frame: Frame,
+    /// Unit direction towards the viewer (world).
+    pub wo: Vec3,
+    /// Indices of the spheres that can occlude this point.
+    pub occluders: Vec<usize>,
+}
+
+impl ShadePoint {
+    /// Exact visibility of direction `d` (unit, world).
+    #[inline]
+    pub fn visible(&self, spheres: &[Sphere], d: DVec3) -> bool {
+        !self
+            .occluders
+            .iter()
+            .any(|&k| spheres[k].blocks(self.pos, d))
+    }
+    /// The frame's axes in `f64` `(t, b, n)`.
+    pub fn axes(&self) -> (DVec3, DVec3, DVec3) {
+        (
+            self.frame.tangent().as_dvec3(),
+            self.frame.bitangent().as_dvec3(),
+            self.frame.normal().as_dvec3(),
+        )
+    }
+}
+
+/// Shading points and occluders.
+#[derive(Clone, Debug)]
+pub struct Scene {
+    /// Occluder spheres.
+    pub spheres: Vec<Sphere>,
+    /// Shading points.
+    pub points: Vec<ShadePoint>,
+}
+
+impl Scene {
+    /// The standard scene (module docs): a `g × g` grid of ground points over
+    /// `[−1.6, 1.6]²` (points within 2 % of a sphere's radius from its contact point are
+    /// left out) and points on the upper half of sphere 0 facing the viewer at the nodes of
+    /// a `g × g` grid in (azimuth, elevation).
+    pub fn standard(g: usize) -> Scene {
+        let spheres = vec![
+            Sphere {
+                centre: DVec3::new(0.0, 0.0, 0.5),
+                radius: 0.5,
+            },
+            Sphere {
+                centre: DVec3::new(0.95, -0.55, 0.3),
+                radius: 0.3,
+            },
+            Sphere {
+                centre: DVec3::new(-0.8, 0.75, 0.25),
+                radius: 0.25,
+            },
+        ];
+        let eye = DVec3::new(3.0, -4.0, 3.0);
+        let mut points = Vec::new();
+        let g = g.max(2);
+        for j in 0..g {
+            for i in 0..g {
+                let x = -1.6 + 3.2 * (i as f64 + 0.5) / g as f64;
+                let y = -1.6 + 3.2 * (j as f64 + 0.5) / g as f64;
+                let pos = DVec3::new(x, y, 0.0);
+                if spheres
+                    .iter()
+                    .any(|s| pos.distance(s.centre) < s.radius * 1.02)
+                {
+                    continue;
+                }
+                push_point(&mut points, pos, DVec3::Z, eye, vec![0, 1, 2]);
+            }
+        }
+        let s0 = spheres[0];
+        for j in 0..g {
+            for i in 0..g {
+                let az = std::f64::consts::TAU * (i as f64 + 0.5) / g as f64;
+                let el = 0.5 * std::f64::consts::FRAC_PI_2 * (1.0 + (j as f64 + 0.5) / g as f64)
+                    - 0.25 * std::f64::consts::FRAC_PI_2;
+                let n = DVec3::new(el.cos() * az.cos(), el.cos() * az.sin(), el.sin());
+                let pos = s0.centre + n * s0.radius;
+                if n.dot((eye - pos).normalize()) < 0.1 {
+                    continue;
+                }
+                push_point(&mut points, pos, n, eye, vec![1, 2]);
+            }
+        }
+        Scene { spheres, points }
+    }
+}
+
+fn push_point(points: &mut Vec<ShadePoint>, pos: DVec3, n: DVec3, eye: DVec3, occ: Vec<usize>) {
+    // A tangent from the world x axis (or y where the normal is along x).
+    let t = if n.x.abs() < 0.9 { DVec3::X } else { DVec3::Y };
+    let frame = Frame::from_normal_tangent(n.as_vec3(), t.as_vec3()).expect("valid normal");
+    points.push(ShadePoint {
+        pos,
+        frame,
+        wo: (eye - pos).normalize().as_vec3(),
+        occluders: occ,
+    });
+}
+
+/// The visibility map of a point on an `n × n` grid: coverage of the union of its
+/// occluders' caps ([`Outside::Visible`]), thresholded at ½, and its VDT.
+pub fn point_vdt(scene: &Scene, p: &ShadePoint, n: usize) -> Vdt {
+    let caps: Vec<_> = p
+        .occluders
+        .iter()
+        .map(|&k| {
+            let s = scene.spheres[k];
+            local_cap(
+                p.pos.as_vec3(),
+                &p.frame,
+                s.centre.as_vec3(),
+                s.radius as f32,
+            )
+            .expect("point outside its occluders")
+        })
+        .collect();
+    let mut cov = vec![0.0f32; n * n];
+    coverage_into(&caps, n, Outside::Visible, &mut cov).expect("valid grid");
+    let mut mask = vec![false; n * n];
+    binary_into(&cov, &mut mask);
+    Vdt::build(n, n, &mask).expect("valid map")
+}
+
+/// Sub-texel samples of a cube map: direction, exact solid angle, texel index.
+#[derive(Clone, Debug)]
+pub struct Samples {
+    /// Sub-texels per texel side.
+    pub sub: usize,
+    /// Unit directions of the sub-texel centres.
+    pub dirs: Vec<DVec3>,
+    /// Exact solid angles.
+    pub weights: Vec<f64>,
+    /// Cube texel of each sample.
+    pub texel: Vec<u32>,
+}
+
+impl Samples {
+    /// `sub × sub` samples per texel of `cube`, in texel order.
+    pub fn new(cube: &CubeMap, sub: usize) -> Samples {
+        let n = cube.n();
+        let sub = sub.max(1);
+        let h = 2.0 / n as f64;
+        let hs = h / sub as f64;
+        let cap = cube.len() * sub * sub;
+        let (mut dirs, mut weights, mut texel) = (
+            Vec::with_capacity(cap),
+            Vec::with_capacity(cap),
+            Vec::with_capacity(cap),
+        );
+        for (f, (nf, u, v)) in FACES.iter().enumerate() {
+            for j in 0..n {
+                for i in 0..n {
+                    let k = ((f * n + j) * n + i) as u32;
+                    for sj in 0..sub {
+                        let b0 = -1.0 + h * j as f64 + hs * sj as f64;
+                        for si in 0..sub {
+                            let a0 = -1.0 + h * i as f64 + hs * si as f64;
+                            weights.push(rect_solid_angle(a0, a0 + hs, b0, b0 + hs));
+                            dirs.push(
+                                (*nf + *u * (a0 + 0.5 * hs) + *v * (b0 + 0.5 * hs)).normalize(),
+                            );
+                            texel.push(k);
+                        }
+                    }
+                }
+            }
+        }
+        Samples {
+            sub,
+            dirs,
+            weights,
+            texel,
+        }
+    }
+}
+
+/// The exact reference `∫ L·ρcos·V dω` (module docs) at every point, RGB.
+pub fn reference(
+    cube: &CubeMap,
+    samples: &Samples,
+    scene: &Scene,
+    brdf: &(dyn Brdf + Sync),
+) -> Vec<[f64; 3]> {
+    par_map(&scene.points, |p| {
+        let (t, b, n) = p.axes();
+        let wo = p.frame.to_local(p.wo);
+        let mut acc = [0.0f64; 3];
+        for (s, d) in samples.dirs.iter().enumerate() {
+            let z = d.dot(n);
+            if z <= 0.0 {
+                continue;
+            }
+            let wi = DVec3::new(d.dot(t), d.dot(b), z).as_vec3();
+            let rho = brdf.eval(wi, wo) as f64;
+            if rho == 0.0 || !p.visible(&scene.spheres, *d) {
+                continue;
+            }
+            let l = cube.texels()[samples.texel[s] as usize];
+            let w = rho * samples.weights[s];
+            for c in 0..3 {
+                acc[c] += l[c] as f64 * w;
+            }
+        }
+        acc
+    })
+}
+
+/// Maps `f` over `items` on all available cores, in order.
+pub fn par_map<T: Sync, R: Send>(items: &[T], f: impl Fn(&T) -> R + Sync) -> Vec<R> {
+    let threads = std::thread::available_parallelism()
+        .map_or(1, |n| n.get())
+        .min(8);
+    let mut out: Vec<Option<R>> = items.iter().map(|_| None).collect();
+    if items.is_empty() {
+        return Vec::new();
+    }
+    let chunk = items.len().div_ceil(threads);
+    std::thread::scope(|s| {
+        for (inp, o) in items.chunks(chunk).zip(out.chunks_mut(chunk)) {
+            let f = &f;
+            s.spawn(move || {
+                for (x, y) in inp.iter().zip(o.iter_mut()) {
+                    *y = Some(f(x));
+                }
+            });
+        }
+    });
+    out.into_iter().flatten().collect()
+}
+
+/// The exact BRDF factor over a square (midpoint rule on `m × m` cells of the square in
+/// the parametrisation plane, the `f32` model, `f64` sums), as a [`BrdfIntegral`]: the
+/// "exact BRDF" swap of the factor analysis.
+pub struct ExactBrdf<'a> {
+    /// The model.
+    pub brdf: &'a (dyn Brdf + Sync),
+    /// Cells per side.
+    pub m: usize,
+}
+
+impl BrdfIntegral for ExactBrdf<'_> {
+    fn integral(&self, wo: Vec3, centre: Vec2, r: f32) -> f32 {
+        let h = f64::from(r) * FRAC_1_SQRT_2;
+        let c = centre.as_dvec2();
+        let step = 2.0 * h / self.m as f64;
+        let mut s = 0.0;
+        for j in 0..self.m {
+            for i in 0..self.m {
+                let q = c + DVec2::new(-h + step * (i as f64 + 0.5), -h + step * (j as f64 + 0.5));
+                if q.length_squared() >= 1.0 {
+                    continue;
+                }
+                let wi = steradian_core::hemisphere::unmap(q.as_vec2());
+                s += f64::from(self.brdf.eval(wi, wo));
+            }
+        }
+        (2.0 * s * step * step) as f32
+    }
+}
+
+/// Exact square means for one point and one light, `f64`:
+/// `(ρ̄, V̄, joint)` with `joint = (1/Ω)∫_R ρcos·V dω` (midpoint rule, `m × m`).
+fn exact_square(
+    scene: &Scene,
+    p: &ShadePoint,
+    brdf: &dyn Brdf,
+    wo: Vec3,
+    centre: Vec2,
+    r: f32,
+    m: usize,
+) -> (f64, f64, f64) {
+    let h = f64::from(r) * FRAC_1_SQRT_2;
+    let c = centre.as_dvec2();
+    let step = 2.0 * h / m as f64;
+    let (t, b, n) = p.axes();
+    let (mut sr, mut sv, mut sj) = (0.0, 0.0, 0.0);
+    for j in 0..m {
+        for i in 0..m {
+            let q = c + DVec2::new(-h + step * (i as f64 + 0.5), -h + step * (j as f64 + 0.5));
+            if q.length_squared() >= 1.0 {
+                sv += 1.0; // outside the disk counts as visible (Outside::Visible)
+                continue;
+            }
+            let wi = steradian_core::hemisphere::unmap(q.as_vec2());
+            let d = (t * f64::from(wi.x) + b * f64::from(wi.y) + n * f64::from(wi.z)).normalize();
+            let vis = p.visible(&scene.spheres, d) as u32 as f64;
+            let rho = f64::from(brdf.eval(wi, wo));
+            sr += rho;
+            sv += vis;
+            sj += rho * vis;
+        }
+    }
+    let cell = step * step;
+    let omega = 8.0 * h * h; // 2·(2h)²
+    (
+        2.0 * sr * cell / omega,
+        sv / (m * m) as f64,
+        2.0 * sj * cell / omega,
+    )
+}
+
+/// The estimates compared in the factor analysis, per point, RGB.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Variant {
+    /// Eq. 5 over the true regions with exact means: `Σ |Sᵢ|·u_L·u_ρ·u_V` (only the
+    /// multi-product approximation; eq. 13 bounds its error).
+    MultiProduct,
+    /// Light uniform over the square: `Σ Eᵢ·(1/Ωᵢ)∫_{Rᵢ} ρV` (only the light's region → square).
+    SquareJoint,
+    /// Eq. 5 with exact square means: `Σ Eᵢ·ρ̄ᵢ·V̄ᵢ` (square + multi-product, exact factors).
+    SquareExact,
+    /// BRDF SAT, exact square visibility.
+    SatExactV,
+    /// Exact square BRDF, VDT visibility (gradient variant).
+    ExactBrdfVdt,
+    /// The kernel: BRDF SAT × VDT (gradient variant), [`shade::shade`].
+    Kernel,
+    /// The kernel with the paper's eq. 9 VDT query.
+    KernelEq9,
+}
+
+/// Every variant, in the order of [`PointResult::values`].
+pub const VARIANTS: [Variant; 7] = [
+    Variant::MultiProduct,
+    Variant::SquareJoint,
+    Variant::SquareExact,
+    Variant::SatExactV,
+    Variant::ExactBrdfVdt,
+    Variant::Kernel,
+    Variant::KernelEq9,
+];
+
+/// Results of one point for one decomposition.
+#[derive(Clone, Debug, Default)]
+pub struct PointResult {
+    /// One RGB estimate per [`VARIANTS`] entry.
+    pub values: Vec<[f64; 3]>,
+    /// Eq. 13 summed over the regions, per channel: bounds `|MultiProduct − reference|`.
+    pub bound: [f64; 3],
+}
+
+/// Settings of [`analyse`].
+#[derive(Clone, Copy, Debug)]
+pub struct Settings {
+    /// Cells per side of the exact square integrals.
+    pub square_cells: usize,
+    /// Compute the exact-square variants (slow for large `K`); otherwise only the region
+    /// variant and the kernels.
+    pub exact_squares: bool,
+}
+
+impl Default for Settings {
+    fn default() -> Self {
+        Settings {
+            square_cells: 24,
+            exact_squares: true,
+        }
+    }
+}
+
+/// Per-region `L` moments (point independent): `|S|`, `E`, and per-channel moments.
+struct RegionL {
+    area: f64,
+    energy: [f64; 3],
+    moments: [Moments; 3],
+}
+
+fn region_l(cube: &CubeMap, samples: &Samples, d: &Decomposition) -> Vec<RegionL> {
+    let k = d.regions.len();
+    let mut members: Vec<Vec<usize>> = vec![Vec::new(); k];
+    for (s, &t) in samples.texel.iter().enumerate() {
+        members[d.region_of[t as usize] as usize].push(s);
+    }
+    members
+        .iter()
+        .map(|ms| {
+            let area: f64 = ms.iter().map(|&s| samples.weights[s]).sum();
+            let mut energy = [0.0; 3];
+            let moments = std::array::from_fn(|c| {
+                let it = ms.iter().map(|&s| {
+                    (
+                        f64::from(cube.texels()[samples.texel[s] as usize][c]),
+                        samples.weights[s],
+                    )
+                });
+                energy[c] = it.clone().map(|(l, w)| l * w).sum();
+                Moments::of_weighted(it)
+            });
+            RegionL {
+                area,
+                energy,
+                moments,
+            }
+        })
+        .collect()
+}
+
+/// Everything [`analyse`] needs.
+pub struct Setup<'a> {
+    /// Environment.
+    pub cube: &'a CubeMap,
+    /// Reference samples.
+    pub samples: &'a Samples,
+    /// Scene.
+    pub scene: &'a Scene,
+    /// Material.
+    pub brdf: &'a (dyn Brdf + Sync),
+    /// Its summed-area tables.
+    pub sat: &'a BrdfSat,
+    /// One VDT per point.
+    pub vdts: &'a [Vdt],
+}
+
+/// Per decomposition, per point: the reference and every [`Variant`] (module docs).
+pub struct Analysis {
+    /// Reference per point (same sub-sampling as the region means).
+    pub reference: Vec<[f64; 3]>,
+    /// `results[d][p]` for decomposition `d` and point `p`.
+    pub results: Vec<Vec<PointResult>>,
+}
+
+/// Runs the factor analysis for each decomposition.
+pub fn analyse(setup: &Setup<'_>, decs: &[&Decomposition], settings: Settings) -> Analysis {
+    let regions: Vec<Vec<RegionL>> = decs
+        .iter()
+        .map(|d| region_l(setup.cube, setup.samples, d))
+        .collect();
+    let lights: Vec<Vec<ShadeLight>> = decs
+        .iter()
+        .map(|d| {
+            d.rsls()
+                .expect("valid RSLs")
+                .iter()
+                .map(ShadeLight::from)
+                .collect()
+        })
+        .collect();
+    let idx: Vec<usize> = (0..setup.scene.points.len()).collect();
+    let per_point = par_map(&idx, |&pi| {
+        let p = &setup.scene.points[pi];
+        let (t, b, n) = p.axes();
+        let wo = p.frame.to_local(p.wo);
+        let ns = setup.samples.dirs.len();
+        let mut rho = vec![0.0f64; ns];
+        let mut vis = vec![0.0f64; ns];
+        let mut refc = [0.0f64; 3];
+        for (s, d) in setup.samples.dirs.iter().enumerate() {
+            let z = d.dot(n);
+            if z > 0.0 {
+                let wi = DVec3::new(d.dot(t), d.dot(b), z).as_vec3();
+                rho[s] = f64::from(setup.brdf.eval(wi, wo));
+            }
+            vis[s] = p.visible(&setup.scene.spheres, *d) as u32 as f64;
+            let l = setup.cube.texels()[setup.samples.texel[s] as usize];
+            let w = rho[s] * vis[s] * setup.samples.weights[s];
+            for c in 0..3 {
+                refc[c] += f64::from(l[c]) * w;
+            }
+        }
+        let vdt = setup.vdts[pi].view();
+        let vis_g = VdtVisibility::new(vdt, VdtQuery::Gradient).expect("square VDT");
+        let vis_9 = VdtVisibility::new(vdt, VdtQuery::Eq9).expect("square VDT");
+        let mut out = Vec::with_capacity(decs.len());
+        for (di, d) in decs.iter().enumerate() {
+            let k = d.regions.len();
+            // Region means of ρ and V, then their moments.
+            let mut sr = vec![0.0f64; k];
+            let mut sv = vec![0.0f64; k];
+            for s in 0..ns {
+                let r = d.region_of[setup.samples.texel[s] as usize] as usize;
+                let w = setup.samples.weights[s];
+                sr[r] += w * rho[s];
+                sv[r] += w * vis[s];
+            }
+            let rl = &regions[di];
+            let ur: Vec<f64> = (0..k).map(|r| sr[r] / rl[r].area).collect();
+            let uv: Vec<f64> = (0..k).map(|r| sv[r] / rl[r].area).collect();
+            let mut m2 = vec![[0.0f64; 2]; k];
+            let mut m3 = vec![[0.0f64; 2]; k];
+            for s in 0..ns {
+                let r = d.region_of[setup.samples.texel[s] as usize] as usize;
+                let w = setup.samples.weights[s];
+                let (dr, dv) = (rho[s] - ur[r], vis[s] - uv[r]);
+                m2[r][0] += w * dr * dr;
+                m2[r][1] += w * dv * dv;
+                m3[r][0] += w * (dr * dr * dr).abs();
+                m3[r][1] += w * (dv * dv * dv).abs();
+            }
+            let mut res = PointResult {
+                values: vec![[0.0; 3]; VARIANTS.len()],
+                bound: [0.0; 3],
+            };
+            for r in 0..k {
+                let a = rl[r].area;
+                let mr = Moments {
+                    mean: ur[r],
+                    sigma: (m2[r][0] / a).sqrt(),
+                    third: (m3[r][0] / a).cbrt(),
+                };
+                let mv = Moments {
+                    mean: uv[r],
+                    sigma: (m2[r][1] / a).sqrt(),
+                    third: (m3[r][1] / a).cbrt(),
+                };
+                for c in 0..3 {
+                    res.values[0][c] += rl[r].energy[c] * ur[r] * uv[r];
+                    res.bound[c] += multi_product_bound(a, &rl[r].moments[c], &mv, &mr);
+                }
+            }
+            // Squares.
+            let frame = &p.frame;
+            for l in &lights[di] {
+                let pc = map_extended(frame.to_local(l.centre));
+                let r = l.half_diagonal;
+                if pc.length() - r >= 1.0 {
+                    continue;
+                }
+                let e = l.energy.map(f64::from);
+                let sat = f64::from(setup.sat.integral(wo, pc, r) * l.inv_solid_angle);
+                let vg = f64::from(shade::SquareVisibility::fraction(&vis_g, pc, r));
+                let v9 = f64::from(shade::SquareVisibility::fraction(&vis_9, pc, r));
+                let mut f = [0.0f64; 7];
+                if settings.exact_squares {
+                    let (er, ev, ej) =
+                        exact_square(setup.scene, p, setup.brdf, wo, pc, r, settings.square_cells);
+                    f[1] = ej;
+                    f[2] = er * ev;
+                    f[3] = sat * ev;
+                    f[4] = er * vg;
+                }
+                f[5] = sat * vg;
+                f[6] = sat * v9;
+                for v in 1..VARIANTS.len() {
+                    for c in 0..3 {
+                        res.values[v][c] += e[c] * f[v];
+                    }
+                }
+            }
+            out.push(res);
+        }
+        (refc, out)
+    });
+    let reference = per_point.iter().map(|(r, _)| *r).collect();
+    let mut results: Vec<Vec<PointResult>> = vec![Vec::new(); decs.len()];
+    for (_, rs) in per_point {
+        for (d, r) in rs.into_iter().enumerate() {
+            results[d].push(r);
+        }
+    }
+    Analysis { reference, results }
+}
+
+/// The kernel itself at every point ([`shade::shade`], gradient VDT), `f32` RGB.
+pub fn shade_points(
+    scene: &Scene,
+    sat: &BrdfSat,
+    vdts: &[Vdt],
+    lights: &[ShadeLight],
+) -> Vec<[f32; 3]> {
+    scene
+        .points
+        .iter()
+        .zip(vdts)
+        .map(|(p, v)| {
+            let vis = VdtVisibility::new(v.view(), VdtQuery::Gradient).expect("square VDT");
+            shade::shade(&p.frame, p.wo, sat, &vis, lights)
+        })
+        .collect()
+}
+
+/// Relative L2 error over points and channels: `sqrt(Σ|a − ref|²/Σ|ref|²)`.
+pub fn rel_l2(values: impl Iterator<Item = [f64; 3]>, reference: &[[f64; 3]]) -> f64 {
+    let (mut num, mut den) = (0.0, 0.0);
+    for (v, r) in values.zip(reference) {
+        for c in 0..3 {
+            num += (v[c] - r[c]) * (v[c] - r[c]);
+            den += r[c] * r[c];
+        }
+    }
+    if den > 0.0 { (num / den).sqrt() } else { 0.0 }
+}
+
+impl Analysis {
+    /// Relative L2 error of `variant` for decomposition `d`.
+    pub fn error(&self, d: usize, variant: Variant) -> f64 {
+        let v = VARIANTS.iter().position(|&x| x == variant).unwrap_or(0);
+        rel_l2(self.results[d].iter().map(|r| r.values[v]), &self.reference)
+    }
+    /// Eq. 13 as a relative L2 "error": `sqrt(Σ bound²/Σ|ref|²)`, an upper bound on
+    /// `error(d, MultiProduct)`.
+    pub fn bound(&self, d: usize) -> f64 {
+        rel_l2(
+            self.results[d]
+                .iter()
+                .zip(&self.reference)
+                .map(|(r, x)| std::array::from_fn(|c| x[c] + r.bound[c])),
+            &self.reference,
+        )
+    }
+}
+
+/// The BRDF SAT for a material and the RSL sizes of the decompositions: target error as
+/// [`BrdfSat::fit`], `r_min`/`r_max` spanning every light's half-diagonal.
+pub fn fit_sat(brdf: &dyn Brdf, decs: &[&Decomposition], target: f32) -> BrdfSat {
+    let (mut lo, mut hi) = (f32::MAX, 0.0f32);
+    for d in decs {
+        for l in d.rsls().expect("valid RSLs") {
+            lo = lo.min(l.half_diagonal());
+            hi = hi.max(l.half_diagonal());
+        }
+    }
+    let mut o = FitOptions::new(target);
+    o.r_min = (0.9 * lo).clamp(1e-3, 1.0);
+    o.r_max = hi.clamp(o.r_min, 2.0);
+    BrdfSat::fit(brdf, &o).expect("valid fit options")
+}
+
+/// The isotropic BRDF SAT as the SIMD kernel reads it: the polar tables' views and
+/// `s_max = sqrt(1 − cos θ_max)`. `None` for an anisotropic table.
+pub fn iso_views(sat: &BrdfSat) -> Option<(Vec<steradian_core::sat::SatView<'_>>, f32)> {
+    let res = sat.resolution();
+    if res.azimuth != 1 {
+        return None;
+    }
+    let views = (0..res.polar)
+        .map(|k| sat.table(k, 0).map(|t| t.view()))
+        .collect::<Option<Vec<_>>>()?;
+    let s_max = (1.0 - sat.theta_max().cos()).sqrt();
+    Some((views, s_max))
+}
+
+/// The SIMD kernel at every point (`steradian_simd::shade::shade_batch`).
+pub fn shade_points_simd(
+    scene: &Scene,
+    sat: &BrdfSat,
+    vdts: &[Vdt],
+    lights: &[ShadeLight],
+    query: VdtQuery,
+) -> Option<Vec<[f32; 3]>> {
+    use steradian_simd::shade::{IsoBrdfTables, ShadeInput, shade_batch};
+    let (views, s_max) = iso_views(sat)?;
+    let tables = IsoBrdfTables {
+        tables: &views,
+        s_max,
+    };
+    let inputs: Vec<ShadeInput<'_>> = scene
+        .points
+        .iter()
+        .zip(vdts)
+        .map(|(p, v)| ShadeInput {
+            frame: p.frame,
+            wo: p.wo,
+            vdt: v.view(),
+        })
+        .collect();
+    let mut out = vec![[0.0f32; 3]; inputs.len()];
+    shade_batch(&inputs, &tables, query, lights, &mut out).then_some(out)
+}
+
+/// The binding-3 table of `wgsl::SHADE` (its layout is documented there), as `f32` bits.
+/// `None` for an anisotropic BRDF SAT or VDTs of different sizes.
+pub fn gpu_table(
+    sat: &BrdfSat,
+    vdts: &[Vdt],
+    lights: &[ShadeLight],
+    query: VdtQuery,
+) -> Option<Vec<f32>> {
+    let (views, s_max) = iso_views(sat)?;
+    let grid = sat.resolution().grid;
+    let vn = vdts.first().map_or(1, |v| v.width());
+    if vdts.iter().any(|v| v.width() != vn || v.height() != vn) {
+        return None;
+    }
+    const HEADER: usize = 9;
+    let off_lights = HEADER;
+    let off_brdf = off_lights + 8 * lights.len();
+    let stride = 1 + 2 * (grid + 1) * (grid + 1);
+    let off_vdt = off_brdf + stride * views.len();
+    let mut w: Vec<u32> = vec![
+        lights.len() as u32,
+        grid as u32,
+        views.len() as u32,
+        s_max.to_bits(),
+        vn as u32,
+        off_lights as u32,
+        off_brdf as u32,
+        off_vdt as u32,
+        (query == VdtQuery::Gradient) as u32,
+    ];
+    for l in lights {
+        w.extend(
+            [
+                l.centre.x,
+                l.centre.y,
+                l.centre.z,
+                l.half_diagonal,
+                l.inv_solid_angle,
+                l.energy[0],
+                l.energy[1],
+                l.energy[2],
+            ]
+            .map(f32::to_bits),
+        );
+    }
+    for v in &views {
+        w.push(v.exponent() as u32);
+        // `gpu_words` = 4 header words, then the entries.
+        w.extend(v.gpu_words().skip(steradian_core::sat::GPU_HEADER_WORDS));
+    }
+    for v in vdts {
+        w.extend(v.samples().iter().map(|x| x.to_bits()));
+    }
+    Some(w.into_iter().map(f32::from_bits).collect())
+}
+
+/// The input columns of `wgsl::SHADE` for every point (point `i` uses VDT `i`).
+pub fn gpu_input(scene: &Scene) -> crate::kernels::Columns {
+    let rows: Vec<[f32; 13]> = scene
+        .points
+        .iter()
+        .enumerate()
+        .map(|(i, p)| {
+            let (t, b, n) = (p.frame.tangent(), p.frame.bitangent(), p.frame.normal());
+            [
+                t.x, t.y, t.z, b.x, b.y, b.z, n.x, n.y, n.z, p.wo.x, p.wo.y, p.wo.z, i as f32,
+            ]
+        })
+        .collect();
+    crate::kernels::Columns::from_rows(&rows)
+}

@@ -1,0 +1,390 @@
+//! RSL shading, 8 shading points at a time (mirrors `steradian_core::shade::shade` with an
+//! isotropic BRDF SAT and a VDT per point).
+//!
+//! Each lane is one shading point; the loop runs over the lights. Per light and lane: the
+//! rotation of the light's centre into the lane's frame, the extended equal-area map, the
+//! horizon cull, the two view-interpolated BRDF SAT square queries and the VDT query, all
+//! lane-wise; only the table reads are scalar (`wide` has no gather). The two BRDF tables
+//! between which a point's view is interpolated are read at the **same** indices (the square
+//! is the same), so the corner arithmetic is done once for both (the scalar kernel repeats
+//! it per table). Exact integer arithmetic of the SAT (`i64x8`) and the `f64x8` combination
+//! follow `steradian_core::sat` operation for operation.
+//!
+//! **Accuracy against the scalar kernel.** Not bit-identical: the map is computed without
+//! the scalar kernel's overflow-safe rescaling (the light centres and frames are unit, so
+//! nothing overflows), and the view's table interpolation constants use `s_max` as given by
+//! the caller. Per light the factor `ρ̄·V̄` agrees with the scalar one to a few `f32` ulps of
+//! the square's coordinates, which moves a VDT query near a steep edge by up to
+//! `~1e-6/r` relative; `simd/tests` and the harness test `simd_matches_scalar_lane_by_lane`
+//! check [`REL_TOL`] per channel (relative to the point's largest channel).
+//!
+//! **Bad input.** Never panics for validated tables; NaN in the frames or views gives NaN
+//! in that lane.
+
+use glam::Vec3;
+use steradian_core::frame::Frame;
+use steradian_core::sat::SatView;
+use steradian_core::shade::{ShadeLight, VdtQuery};
+use steradian_core::vdt::{Q_MIN, R_MAX, R_MIN, VdtView};
+use wide::{f32x8, f64x8, i64x8};
+
+/// Relative difference allowed between [`shade_batch`] and the scalar kernel, per channel,
+/// relative to the point's largest channel (see the module docs).
+pub const REL_TOL: f32 = 2.0e-5;
+
+/// An isotropic BRDF SAT as the SIMD kernel reads it: the tables of the polar view nodes
+/// `k = 0..m` (`BrdfSat::table(k, 0)`), all of the same size, and `s_max`, the equal-area
+/// radius of the last node (`sqrt(1 − cos θ_max)`).
+#[derive(Clone, Copy, Debug)]
+pub struct IsoBrdfTables<'a> {
+    /// The tables, one per polar node (at least 2).
+    pub tables: &'a [SatView<'a>],
+    /// Equal-area radius of the last node.
+    pub s_max: f32,
+}
+
+/// One shading point.
+#[derive(Clone, Copy, Debug)]
+pub struct ShadeInput<'a> {
+    /// The local frame.
+    pub frame: Frame,
+    /// Unit view direction (world).
+    pub wo: Vec3,
+    /// The point's VDT (square).
+    pub vdt: VdtView<'a>,
+}
+
+/// Per-lane view constants: table index, interpolation weight, view rotation.
+#[derive(Clone, Copy)]
+struct ViewLane {
+    k0: usize,
+    t: f32,
+    c: f32,
+    s: f32,
+    front: bool,
+}
+
+fn view_lane(tables: &IsoBrdfTables<'_>, wo: Vec3) -> ViewLane {
+    let m = tables.tables.len();
+    let p = steradian_core::hemisphere::map(wo);
+    let s = (p.x * p.x + p.y * p.y).sqrt();
+    let x = (s / tables.s_max * (m - 1) as f32).clamp(0.0, (m - 1) as f32);
+    let k0 = (x as usize).min(m - 2);
+    let (c, sn) = if s > 0.0 {
+        (p.x / s, p.y / s)
+    } else {
+        (1.0, 0.0)
+    };
+    ViewLane {
+        k0,
+        t: x - k0 as f32,
+        c,
+        s: sn,
+        front: wo.z > 0.0,
+    }
+}
+
+#[inline(always)]
+fn sel(m: f32x8, t: f32x8, f: f32x8) -> f32x8 {
+    m.select(t, f)
+}
+
+/// `steradian_core::sat::axis` lane-wise: `(I0, a0, I1, a1)` for `lo ≤ hi` (no NaN).
+#[inline(always)]
+fn sat_axis(lo: f32x8, hi: f32x8, n: usize) -> (f32x8, f32x8, f32x8, f32x8) {
+    let nf = f32x8::splat(n as f32);
+    let zero = f32x8::ZERO;
+    let clip = |x: f32x8| {
+        let x = sel(x.simd_gt(nf), nf, x);
+        sel(x.simd_lt(zero), zero, x)
+    };
+    let (lo, hi) = (clip(lo), clip(hi));
+    let last = f32x8::splat((n - 1) as f32);
+    let fm = |x: f32x8| {
+        let f = x.floor();
+        sel(f.simd_gt(last), last, f)
+    };
+    let (i0, i1) = (fm(lo), fm(hi));
+    (i0, lo - i0, i1, hi - i1)
+}
+
+#[inline(always)]
+fn idx(x: f32x8) -> [usize; 8] {
+    x.trunc_int().to_array().map(|i| i.max(0) as usize)
+}
+
+#[inline(always)]
+fn widen(x: f32x8) -> f64x8 {
+    f64x8::new(x.to_array().map(f64::from))
+}
+
+/// Two box sums per lane over the same boxes in tables `k0` and `k0 + 1` of each lane.
+#[inline(always)]
+fn box_pair(
+    tables: &[SatView<'_>],
+    views: &[ViewLane; 8],
+    (u0, v0, u1, v1): (f32x8, f32x8, f32x8, f32x8),
+    width: usize,
+    height: usize,
+) -> (f32x8, f32x8) {
+    let (i0, a0, i1, a1) = sat_axis(u0, u1, width);
+    let (j0, b0, j1, b1) = sat_axis(v0, v1, height);
+    let (i0, i1, j0, j1) = (idx(i0), idx(i1), idx(j0), idx(j1));
+    let w1 = width + 1;
+    // g[t][row*4 + col][lane]: rows J0, J0+1, J1, J1+1; columns I0, I0+1, I1, I1+1.
+    let mut g = [[[0i64; 8]; 16]; 2];
+    let mut quanta = [[0.0f64; 8]; 2];
+    for k in 0..8 {
+        let kk = views[k].k0;
+        for (tt, gt) in g.iter_mut().enumerate() {
+            let Some(tab) = tables.get(kk + tt) else {
+                continue;
+            };
+            quanta[tt][k] = tab.quantum();
+            let sums = tab.sums();
+            for (r, l) in [j0[k], j0[k] + 1, j1[k], j1[k] + 1].into_iter().enumerate() {
+                for (c, i) in [i0[k], i1[k]].into_iter().enumerate() {
+                    let at = l * w1 + i;
+                    let [x, y] = match sums.get(at..at + 2) {
+                        Some(&[x, y]) => [x, y],
+                        _ => [0, 0],
+                    };
+                    gt[4 * r + 2 * c][k] = x;
+                    gt[4 * r + 2 * c + 1][k] = y;
+                }
+            }
+        }
+    }
+    let (a0, a1, b0, b1) = (widen(a0), widen(a1), widen(b0), widen(b1));
+    let one = |gt: &[[i64; 8]; 16], q: [f64; 8]| -> f32x8 {
+        let row = |r: usize| -> [i64x8; 4] { core::array::from_fn(|c| i64x8::new(gt[4 * r + c])) };
+        let (r0, r0p, r1, r1p) = (row(0), row(1), row(2), row(3));
+        let x = |l: [i64x8; 4], m: [i64x8; 4]| -> f64x8 {
+            let p = (m[2] - m[0]) - (l[2] - l[0]);
+            let e1 = (m[3] - m[2]) - (l[3] - l[2]);
+            let e0 = (m[1] - m[0]) - (l[1] - l[0]);
+            (p.round_float() + a1 * e1.round_float()) - a0 * e0.round_float()
+        };
+        let (xb, xt, xd) = (x(r0, r1), x(r1, r1p), x(r0, r0p));
+        let v = ((xb + b1 * xt) - b0 * xd) * f64x8::new(q);
+        f32x8::new(v.to_array().map(|v| v as f32))
+    };
+    (one(&g[0], quanta[0]), one(&g[1], quanta[1]))
+}
+
+/// The straight-edge fraction (`steradian_core::vdt::square_halfplane_fraction` after the
+/// reduction of the normal to `q`), lane-wise.
+#[inline(always)]
+fn edge_fraction(t: f32x8, q: f32x8) -> f32x8 {
+    let one = f32x8::ONE;
+    let len = (one + q * q).sqrt();
+    let hi = one + q;
+    let tt = t * len;
+    let tt = sel(tt.simd_gt(hi), hi, sel(tt.simd_lt(-hi), -hi, tt));
+    let qm = f32x8::splat(Q_MIN);
+    let den = f32x8::splat(8.0) * sel(q.simd_gt(qm), q, qm);
+    let lo_e = tt + hi;
+    let lo_v = lo_e * lo_e / den;
+    let hi_e = hi - tt;
+    let hi_v = one - hi_e * hi_e / den;
+    let mid = (tt + one) * f32x8::splat(0.5);
+    let r = sel(tt.simd_ge(one - q), hi_v, mid);
+    sel(tt.simd_le(q - one), lo_v, r)
+}
+
+/// VDT visible fractions per lane for squares `(u, v, r)` in texel units.
+#[inline(always)]
+fn vdt_lanes(
+    vdts: &[VdtView<'_>; 8],
+    n: usize,
+    u: f32x8,
+    v: f32x8,
+    r: f32x8,
+    query: VdtQuery,
+) -> f32x8 {
+    let hi_index = f32x8::splat(if n >= 2 { (n - 2) as f32 } else { 0.0 });
+    let hi_frac = f32x8::splat(if n >= 2 { 1.0 } else { 0.0 });
+    let zero = f32x8::ZERO;
+    let ax = |x: f32x8| {
+        let c = x - f32x8::splat(0.5);
+        let f = c.floor();
+        let i0 = sel(f.simd_gt(hi_index), hi_index, sel(f.simd_lt(zero), zero, f));
+        let fr = c - i0;
+        let fr = sel(
+            fr.simd_gt(hi_frac),
+            hi_frac,
+            sel(fr.simd_lt(zero), zero, fr),
+        );
+        (i0, fr)
+    };
+    let (i0, fx) = ax(u);
+    let (j0, fy) = ax(v);
+    let (i0, j0) = (idx(i0), idx(j0));
+    let mut d = [[0.0f32; 8]; 4];
+    for k in 0..8 {
+        let s = vdts[k].samples();
+        let i1 = (i0[k] + 1).min(n - 1);
+        let j1 = (j0[k] + 1).min(n - 1);
+        let at = |i: usize, j: usize| s.get(j * n + i).copied().unwrap_or(0.0);
+        d[0][k] = at(i0[k], j0[k]);
+        d[1][k] = at(i1, j0[k]);
+        d[2][k] = at(i0[k], j1);
+        d[3][k] = at(i1, j1);
+    }
+    let [d00, d10, d01, d11] = d.map(f32x8::new);
+    let one = f32x8::ONE;
+    let lerp = |a: f32x8, b: f32x8, t: f32x8| (one - t) * a + t * b;
+    let d0 = lerp(d00, d10, fx);
+    let d1 = lerp(d01, d11, fx);
+    let dd = lerp(d0, d1, fy);
+    let (rmin, rmax) = (f32x8::splat(R_MIN), f32x8::splat(R_MAX));
+    let rr = sel(r.simd_lt(rmin), rmin, sel(r.simd_gt(rmax), rmax, r));
+    let sqrt2 = f32x8::splat(core::f32::consts::SQRT_2);
+    match query {
+        VdtQuery::Eq9 => {
+            let k = sqrt2 * rr;
+            let e = (k + dd) / (f32x8::splat(2.0) * k);
+            sel(e.simd_lt(zero), zero, sel(e.simd_gt(one), one, e))
+        }
+        VdtQuery::Gradient => {
+            let gx = lerp(d10 - d00, d11 - d01, fy).abs();
+            let gy = lerp(d01 - d00, d11 - d10, fx).abs();
+            let m = sel(gx.simd_gt(gy), gx, gy);
+            let mn = sel(gx.simd_lt(gy), gx, gy);
+            let q = sel(m.simd_gt(zero), mn / m, zero);
+            edge_fraction(dd * sqrt2 / rr, q)
+        }
+    }
+}
+
+/// Shades 8 points (lane `k` = `points[k]`), RGB per lane. All VDTs must have the same
+/// square size `n` and the BRDF tables the same size; otherwise (or with fewer than 2
+/// tables) returns `None`.
+pub fn shade_x8(
+    points: &[ShadeInput<'_>; 8],
+    brdf: &IsoBrdfTables<'_>,
+    query: VdtQuery,
+    lights: &[ShadeLight],
+) -> Option<[[f32; 3]; 8]> {
+    let tabs = brdf.tables;
+    let first = tabs.first()?;
+    let (bw, bh) = (first.width(), first.height());
+    if tabs.len() < 2 || tabs.iter().any(|t| t.width() != bw || t.height() != bh) {
+        return None;
+    }
+    let n = points[0].vdt.width();
+    if points
+        .iter()
+        .any(|p| p.vdt.width() != n || p.vdt.height() != n)
+    {
+        return None;
+    }
+    let views: [ViewLane; 8] =
+        core::array::from_fn(|k| view_lane(brdf, points[k].frame.to_local(points[k].wo)));
+    let lane = |f: &dyn Fn(usize) -> f32| f32x8::new(core::array::from_fn(f));
+    let axes: [Vec3; 3] = [Vec3::X, Vec3::Y, Vec3::Z];
+    // Frame rows: local = (c·t, c·b, c·n).
+    let row = |k: usize, a: usize| -> Vec3 {
+        let f = &points[k].frame;
+        [f.tangent(), f.bitangent(), f.normal()][a]
+    };
+    let fr: [[f32x8; 3]; 3] =
+        core::array::from_fn(|a| core::array::from_fn(|c| lane(&|k| row(k, a).dot(axes[c]))));
+    let rot_c = lane(&|k| views[k].c);
+    let rot_s = lane(&|k| views[k].s);
+    let tw = lane(&|k| views[k].t);
+    let front = lane(&|k| if views[k].front { 1.0 } else { 0.0 }).simd_gt(f32x8::ZERO);
+    // NaN frames or views poison their lane.
+    let nan = lane(&|k| {
+        let p = &points[k];
+        let w = p.frame.to_local(p.wo);
+        if w.is_nan() { f32::NAN } else { 0.0 }
+    });
+    let vdts: [VdtView<'_>; 8] = core::array::from_fn(|k| points[k].vdt);
+    let half_b = f32x8::splat(0.5 * bw as f32);
+    let half_v = f32x8::splat(0.5 * n as f32);
+    let one = f32x8::ONE;
+    let mut acc = [f32x8::ZERO; 3];
+    for l in lights {
+        let c = l.centre;
+        let x = fr[0][0] * c.x + fr[0][1] * c.y + fr[0][2] * c.z;
+        let y = fr[1][0] * c.x + fr[1][1] * c.y + fr[1][2] * c.z;
+        let z = fr[2][0] * c.x + fr[2][1] * c.y + fr[2][2] * c.z;
+        let inv = one / (x * x + y * y + z * z).sqrt();
+        let (x, y, z) = (x * inv, y * inv, z * inv);
+        // Extended equal-area map: (x, y)/sqrt(1 + z) above, (x, y)·sqrt(1 − z)/|xy| below.
+        let s2 = x * x + y * y;
+        let up = z.simd_ge(f32x8::ZERO);
+        let k_up = one / (one + z.abs()).sqrt();
+        let k_dn = sel(
+            s2.simd_gt(f32x8::ZERO),
+            (one - z).sqrt() / s2.sqrt(),
+            f32x8::ZERO,
+        );
+        let k = sel(up, k_up, k_dn);
+        let px = sel(
+            up | s2.simd_gt(f32x8::ZERO),
+            x * k,
+            f32x8::splat(core::f32::consts::SQRT_2),
+        );
+        let py = y * k;
+        let r = f32x8::splat(l.half_diagonal);
+        let live = ((px * px + py * py).sqrt() - r).simd_lt(one) & front;
+        if !live.any() {
+            continue;
+        }
+        // BRDF: centre rotated by −φₒ, square in table texels.
+        let qx = px * rot_c + py * rot_s;
+        let qy = py * rot_c - px * rot_s;
+        let tcx = (qx + one) * half_b;
+        let tcy = (qy + one) * half_b;
+        let h = r * half_b * f32x8::splat(core::f32::consts::FRAC_1_SQRT_2);
+        let (v0, v1) = box_pair(tabs, &views, (tcx - h, tcy - h, tcx + h, tcy + h), bw, bh);
+        let rho = (v0 + tw * (v1 - v0)) * f32x8::splat(l.inv_solid_angle);
+        let vis = vdt_lanes(
+            &vdts,
+            n,
+            (px + one) * half_v,
+            (py + one) * half_v,
+            r * half_v,
+            query,
+        );
+        let f = sel(live, rho * vis, f32x8::ZERO) + nan;
+        for (ch, a) in acc.iter_mut().enumerate() {
+            *a += f32x8::splat(l.energy[ch]) * f;
+        }
+    }
+    let acc = acc.map(|a| sel(front, a, f32x8::ZERO) + nan);
+    let arr = acc.map(|a| a.to_array());
+    Some(core::array::from_fn(|k| [arr[0][k], arr[1][k], arr[2][k]]))
+}
+
+/// Shades every point (`out[i]` for `points[i]`), 8 at a time; the tail is padded with the
+/// last point. Returns `false` (leaving `out` untouched) if the tables or VDTs do not fit
+/// [`shade_x8`]'s requirements or the lengths differ.
+pub fn shade_batch(
+    points: &[ShadeInput<'_>],
+    brdf: &IsoBrdfTables<'_>,
+    query: VdtQuery,
+    lights: &[ShadeLight],
+    out: &mut [[f32; 3]],
+) -> bool {
+    if points.len() != out.len() {
+        return false;
+    }
+    let Some(last) = points.last() else {
+        return true;
+    };
+    let mut i = 0;
+    while i < points.len() {
+        let group: [ShadeInput<'_>; 8] =
+            core::array::from_fn(|k| *points.get(i + k).unwrap_or(last));
+        let Some(r) = shade_x8(&group, brdf, query, lights) else {
+            return false;
+        };
+        let m = (points.len() - i).min(8);
+        out[i..i + m].copy_from_slice(&r[..m]);
+        i += 8;
+    }
+    true
+}
