@@ -59,12 +59,21 @@ extern crate alloc;
 mod error;
 mod math;
 
+pub mod brdf;
+#[cfg(feature = "alloc")]
+pub mod brdf_sat;
 pub mod cap;
 pub mod frame;
 pub mod hemisphere;
 pub mod lobe;
+pub mod lobe_sum;
 pub mod product;
+pub mod rsl;
+pub mod sat;
+pub mod shade;
 pub mod table;
+pub mod vdt;
+pub mod visibility;
 pub mod wgsl;
 
 pub use error::Error;

@@ -104,6 +104,95 @@ pub const CAP_EXPONENT: &str = concat!(
     include_str!("wgsl/cap_exponent.wgsl")
 );
 
+/// Summed-area table box query (`sat::SatView::box_sum`). Input columns `[u0, v0, u1, v1]`,
+/// output `[value]`. Binding 3 is the table as **`array<u32>`** in the layout of
+/// `sat::SatView::gpu_words` (header `[width, height, exponent, 0]`, then each `i64` entry
+/// as its low and high words); a caller with an `f32` binding passes the same bits
+/// (`f32::from_bits`). Not in [`ALL`] (no built-in table): run it with the harness's custom
+/// kernels. Same algorithm as the scalar kernel: the nine sub-box sums are exact 64-bit
+/// integer differences (`u32` pairs with borrow), converted to `f32` by magnitude and
+/// combined in `f32` (not `f64`), then scaled by `2^e` with two `ldexp` steps.
+/// Tolerance: [`SAT_BOX_REL_TOL`].
+pub const SAT_BOX: &str = concat!(
+    include_str!("wgsl/batch.wgsl"),
+    include_str!("wgsl/sat.wgsl")
+);
+/// Difference allowed between [`SAT_BOX`] and `sat::SatView::box_sum`, relative to
+/// `A = Σ|t|` over the texels the query reads (`sat` module docs): nine conversions and
+/// seven operations in `f32`, each within about one ulp of a term bounded by `A`.
+/// Lavapipe: `2.4e-7·A` (about 4 ulps of `A`) on grids from 1×1 to 1024², magnitudes
+/// `1e-30` to `1e12`, mixed signs (the harness test `tests/sat.rs` prints it). For texels of
+/// one sign `A` exceeds the box integral only by the partly covered edge texels, so the GPU
+/// result is within a few ulps of the box's own magnitude there too.
+pub const SAT_BOX_REL_TOL: f32 = 1.0e-6;
+
+/// Visibility distance table query (`vdt::VdtView::query`): input columns `[u, v, r]`
+/// (centre and half-diagonal in texel units), output `[eq9, gradient]`. Binding 3 is the
+/// table `[w, h, D…]` of `vdt::Vdt::gpu_table` (`w`, `h` as `f32`, samples row-major). Not
+/// in [`ALL`] (no built-in table): run it with the harness's custom kernels. Same
+/// operations as the scalar kernel (bilinear `(1 − t)·a + t·b`, in-cell gradient, eq. 9,
+/// straight-edge fraction). Tolerance: [`VDT_QUERY_TOL`].
+pub const VDT_QUERY: &str = concat!(
+    include_str!("wgsl/batch.wgsl"),
+    include_str!("wgsl/vdt.wgsl")
+);
+/// Difference allowed between [`VDT_QUERY`] and `vdt::VdtView::query` per output, in units
+/// of `1 + |t|` with `t = D·√2/r` the distance in half-sides (WGSL division is 2.5 ulp and a
+/// compiler may fuse the bilinear `a·b + c`, which moves `D` by ulps that the ramp divides
+/// by the half-side). Lavapipe: bit-identical (harness test `tests/vdt_gpu.rs`).
+pub const VDT_QUERY_TOL: f32 = 2.0e-6;
+
+/// RSL shading of one point per invocation (`shade::shade` with an isotropic BRDF SAT and
+/// one VDT per point). Input columns `[tx, ty, tz, bx, by, bz, nx, ny, nz, wox, woy, woz,
+/// vdt_index]` (frame axes, world view, which VDT), output `[r, g, b]`. Binding 3 is one
+/// **`array<u32>`** table (a caller with an `f32` binding passes the same bits): header
+/// `[lights, grid, polar, s_max (f32 bits), vdt_n, off_lights, off_brdf, off_vdt, query
+/// (0 = eq. 9, 1 = gradient)]`, then per light 8 `f32` words `[cx, cy, cz, r, 1/Ω, E_r,
+/// E_g, E_b]`, per BRDF table (polar node `k`) its exponent word and its `i64` entries as
+/// in `sat::SatView::gpu_words`, and per point `vdt_n²` `f32` distances. The harness's
+/// `shade::gpu_table` builds it. Same operations as the scalar kernel except the SAT
+/// combination in `f32` (as [`SAT_BOX`]) and the map without the overflow-safe rescaling.
+/// Tolerance: [`SHADE_REL_TOL`].
+pub const SHADE: &str = concat!(
+    include_str!("wgsl/batch.wgsl"),
+    include_str!("wgsl/shade.wgsl")
+);
+/// Difference allowed between [`SHADE`] and `shade::shade`, per channel, relative to the
+/// point's largest channel (the `f32` SAT combination is within about `10⁻⁶` of the
+/// table's local magnitude; a VDT edge query moves by ulps of the square's coordinates over
+/// its half-side).
+pub const SHADE_REL_TOL: f32 = 1.0e-4;
+
+/// Product of two cosine lobes as one lobe (`product::product_with` with
+/// `ProductFit::ExactIntegral`, the only fit on the GPU). Input columns
+/// `[a1x, a1y, a1z, s1, e1, a2x, a2y, a2z, s2, e2]` (unit axes, as `CosineLobe` stores
+/// them), output `[ax, ay, az, scale, exponent]`. Binding 3 is the table
+/// `[exponents, angles, g…]`: the two sizes as `f32`, then the `g` values of
+/// `product::ProductTable` in its packed layout, decoded to `f32` (the harness's
+/// `backend::gpu_product` builds it from `product::TABLE_BYTES` or any table file). Not in
+/// [`ALL`]: run it with the harness's custom kernels. Same formulas and order as the scalar
+/// kernel (arc frame, closed-form peak, logit-Laplace baseline, trilinear correction);
+/// its `log` and `log1p` are computed without WGSL's `log` (an `atanh` series after
+/// `frexp`, as in [`LOBE_EVAL`]) and its `atan2` with Cephes' `atanf` polynomial (WGSL's
+/// `atan2` promises only 4096 ulp, and lavapipe's lost relative precision for small angles:
+/// `6e-6` per unit of `1 + L` in the exponent); `exp` and `sqrt` are WGSL's. Axes within
+/// about `1e-18` of opposite, where the baseline's intermediates overflow, are outside the
+/// finite-input contract. Tolerance: [`LOBE_PRODUCT_TOL`].
+pub const LOBE_PRODUCT: &str = concat!(
+    include_str!("wgsl/batch.wgsl"),
+    include_str!("wgsl/product.wgsl")
+);
+/// Difference allowed between [`LOBE_PRODUCT`] and `product::product_with`
+/// (`ExactIntegral`), per output: axis components absolutely; the scale relative per unit of
+/// `1 + L`, the exponent relative to `1 + e_r` per unit of `1 + L`, and the integral
+/// `2π·s/(e_r + 1)` relative per unit of `1 + L`, with `L = |ln p| + |ln I|` the size of
+/// the logarithms the outputs are exponentials of (`p` the peak value, `I` the integral of
+/// the product of the unit lobes; see `steradian_simd::product` for the same bound on the
+/// CPU). Results below `|s1·s2|·2⁻¹²⁶` may be flushed to 0. Lavapipe, over 10⁵ random
+/// pairs and the named hard cases (harness test `tests/product_gpu.rs`, which prints them):
+/// axis `1.2e-7`, scale `2.3e-7`, exponent `4.6e-7`, integral `5.5e-7`.
+pub const LOBE_PRODUCT_TOL: f32 = 1.0e-5;
+
 /// Every kernel as `(name, source)`, the name as in the harness (`hemisphere-map`, …).
 pub const ALL: [(&str, &str); 5] = [
     ("hemisphere-map", HEMISPHERE_MAP),

@@ -15,17 +15,26 @@ fuzz_target!(|data: [u32; 5]| {
         let n = normalize_or_zero(d);
         let back = hemisphere::unmap(p);
         let want = Vec3::new(n.x, n.y, n.z.abs());
-        assert!((back - want).abs().max_element() < 2e-6, "{d}: {back} vs {want}");
+        assert!(
+            (back - want).abs().max_element() < 2e-6,
+            "{d}: {back} vs {want}"
+        );
     } else if !d.is_finite() {
         assert!(p.is_nan() || p.is_finite(), "never infinite");
     }
     let q = Vec2::new(u, v);
     let dir = hemisphere::unmap(q);
     if q.is_finite() {
-        assert!((dir.length() - 1.0).abs() < 1e-6 && dir.z >= 0.0, "unmap({q}) = {dir}");
+        assert!(
+            (dir.length() - 1.0).abs() < 1e-6 && dir.z >= 0.0,
+            "unmap({q}) = {dir}"
+        );
         if q.length_squared() <= 1.0 {
             let again = hemisphere::map(dir);
-            assert!((again - q).abs().max_element() < 2e-6, "{q} → {dir} → {again}");
+            assert!(
+                (again - q).abs().max_element() < 2e-6,
+                "{q} → {dir} → {again}"
+            );
         }
     }
 });

@@ -35,26 +35,53 @@ fuzz_target!(|data: &[u8]| {
         let s = hemisphere::map(Vec3::new(c[0][l], c[1][l], c[2][l]));
         assert!(same(s.x, pu[l]) && same(s.y, pv[l]), "map lane {l}");
         let s = hemisphere::unmap(Vec2::new(c[0][l], c[1][l]));
-        assert!(same(s.x, dx[l]) && same(s.y, dy[l]) && same(s.z, dz[l]), "unmap lane {l}");
-        assert!(same(lobe::integral(c[3][l], c[4][l]), integ[l]), "integral lane {l}");
+        assert!(
+            same(s.x, dx[l]) && same(s.y, dy[l]) && same(s.z, dz[l]),
+            "unmap lane {l}"
+        );
+        assert!(
+            same(lobe::integral(c[3][l], c[4][l]), integ[l]),
+            "integral lane {l}"
+        );
         let e = cap::exponent_l2(c[5][l]);
         assert!(same(e, ex[l]), "cap lane {l}");
-        assert!(e.is_nan() || (e >= 0.0 && e.is_finite()), "cap exponent {e}");
+        assert!(
+            e.is_nan() || (e >= 0.0 && e.is_finite()),
+            "cap exponent {e}"
+        );
     }
 
     // Lobe evaluation on unit axes and directions made from the fuzz data.
     let unit = |x: f32, y: f32, z: f32| {
         let u = steradian_core::frame::normalize_or_zero(Vec3::new(x, y, z));
-        if u.is_finite() && u != Vec3::ZERO { u } else { Vec3::Z }
+        if u.is_finite() && u != Vec3::ZERO {
+            u
+        } else {
+            Vec3::Z
+        }
     };
     let axes: Vec<Vec3> = (0..8).map(|l| unit(c[0][l], c[1][l], c[2][l])).collect();
     let dirs: Vec<Vec3> = (0..8).map(|l| unit(c[5][l], c[6][l], c[7][l])).collect();
-    let scale: Vec<f32> = (0..8).map(|l| if c[3][l].is_finite() { c[3][l] } else { 1.0 }).collect();
-    let expo: Vec<f32> = (0..8).map(|l| c[4][l].abs().min(1e6)).map(|e| if e.is_nan() { 0.0 } else { e }).collect();
+    let scale: Vec<f32> = (0..8)
+        .map(|l| if c[3][l].is_finite() { c[3][l] } else { 1.0 })
+        .collect();
+    let expo: Vec<f32> = (0..8)
+        .map(|l| c[4][l].abs().min(1e6))
+        .map(|e| if e.is_nan() { 0.0 } else { e })
+        .collect();
     let col = |f: &dyn Fn(usize) -> f32| f32x8::from(core::array::from_fn::<f32, 8, _>(f));
-    let ax = steradian_simd::Vec3x8::new(col(&|l| axes[l].x), col(&|l| axes[l].y), col(&|l| axes[l].z));
-    let dv = steradian_simd::Vec3x8::new(col(&|l| dirs[l].x), col(&|l| dirs[l].y), col(&|l| dirs[l].z));
-    let got = steradian_simd::lobe::eval_parts(ax, col(&|l| scale[l]), col(&|l| expo[l]), dv).to_array();
+    let ax = steradian_simd::Vec3x8::new(
+        col(&|l| axes[l].x),
+        col(&|l| axes[l].y),
+        col(&|l| axes[l].z),
+    );
+    let dv = steradian_simd::Vec3x8::new(
+        col(&|l| dirs[l].x),
+        col(&|l| dirs[l].y),
+        col(&|l| dirs[l].z),
+    );
+    let got =
+        steradian_simd::lobe::eval_parts(ax, col(&|l| scale[l]), col(&|l| expo[l]), dv).to_array();
     for l in 0..8 {
         let want = lobe::eval(axes[l], scale[l], expo[l], dirs[l]);
         let g = got[l];
@@ -69,7 +96,10 @@ fuzz_target!(|data: &[u8]| {
         assert!(
             (g - want).abs() <= tol || (g.is_infinite() && g == want),
             "eval lane {l}: scalar {want} simd {g} (axis {:?} s {} e {} v {:?})",
-            axes[l], scale[l], expo[l], dirs[l]
+            axes[l],
+            scale[l],
+            expo[l],
+            dirs[l]
         );
     }
 });

@@ -30,6 +30,11 @@ fuzz_target!(|data: &[u8]| {
         let at = u32::from_le_bytes([data[0], data[1], data[2], data[3]]) as usize % bytes.len();
         bytes[at] ^= data[4];
         let parsed = TableView::parse_expecting(&bytes, cap::TABLE_NAME, cap::TABLE_LEN);
-        assert_eq!(parsed.is_ok(), data[4] == 0, "flip of byte {at} by {:#x}", data[4]);
+        assert_eq!(
+            parsed.is_ok(),
+            data[4] == 0,
+            "flip of byte {at} by {:#x}",
+            data[4]
+        );
     }
 });

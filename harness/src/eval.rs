@@ -31,12 +31,20 @@ pub const KERNELS: &[(&str, &str)] = &[
         r#"{"dir": [x,y,z] with z ≥ 0, any non-zero length} -> {"p": [u,v]}"#,
     ),
     (
+        "hemisphere-unmap",
+        r#"{"p": [u,v] with u²+v² ≤ 1} -> {"dir": [x,y,z]}"#,
+    ),
+    (
         "lobe-product",
         r#"{"e1": e1, "e2": e2, "alpha": α} -> {"scale": p, "exponent": e_r, "axis_angle": β, "integral": 2πp/(e_r+1)} (unit lobes, a1 = +z, a2 toward +x)"#,
     ),
     (
-        "hemisphere-unmap",
-        r#"{"p": [u,v] with u²+v² ≤ 1} -> {"dir": [x,y,z]}"#,
+        "sat-box",
+        r#"{"grid": [[t00, t10, …], …] (rows in v), "queries": [[u0, v0, u1, v1], …] (texel units)} -> {"values": [∫ over each box]}"#,
+    ),
+    (
+        "vdt-box",
+        r#"{"mask": ["0110…", …] rows of '0'/'1' ('1' visible, row j along v), "queries": [[u, v, r], …] centre and half-diagonal in texel units} -> {"values": [visible fraction, eq. 9], "values_gradient": [straight-edge variant]}"#,
     ),
 ];
 
@@ -113,6 +121,7 @@ pub fn eval_line(kernel: &str, line: &str) -> Result<Value, String> {
         .as_object()
         .ok_or_else(|| "each line must be a JSON object".to_string())?;
     match kernel {
+        "sat-box" => crate::sat::eval_sat_box(obj),
         "lobe-product" => crate::product::eval_lobe_product(obj),
         "lobe-integral" => {
             let (e, s) = (exponent(obj)?, scale(obj)?);
@@ -158,6 +167,7 @@ pub fn eval_line(kernel: &str, line: &str) -> Result<Value, String> {
             let d = hemisphere::unmap(Vec2::new(u, v));
             Ok(json!({ "dir": [num(d.x), num(d.y), num(d.z)] }))
         }
+        "vdt-box" => crate::vdt::eval_vdt_box(line),
         other => Err(format!("unknown kernel {other}")),
     }
 }

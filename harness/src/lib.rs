@@ -6,11 +6,15 @@
 
 pub mod accuracy;
 pub mod backend;
+pub mod env;
 pub mod eval;
 pub mod generate;
-pub mod product;
 pub mod kernels;
+pub mod product;
 pub mod reference;
 pub mod report;
 pub mod rng;
+pub mod sat;
+pub mod shade;
+pub mod vdt;
 pub mod workload;

@@ -385,7 +385,10 @@ fn random_config(rng: &mut Rng) -> Config {
             .unwrap(),
         )
     };
-    let wo = dir(rng.range(0.0, 1.4) as f32, rng.range(0.0, std::f64::consts::TAU) as f32);
+    let wo = dir(
+        rng.range(0.0, 1.4) as f32,
+        rng.range(0.0, std::f64::consts::TAU) as f32,
+    );
     // Lights near the mirror direction half of the time (highlights), else anywhere above
     // or straddling the horizon.
     let mirror = lobe_sum_mirror(wo);
@@ -394,7 +397,10 @@ fn random_config(rng: &mut Rng) -> Config {
         let axis = if rng.unit() < 0.5 {
             (mirror + 0.2 * Vec3::from(rng.sphere().map(|x| x as f32))).normalize()
         } else {
-            dir(rng.range(0.0, 1.75) as f32, rng.range(0.0, std::f64::consts::TAU) as f32)
+            dir(
+                rng.range(0.0, 1.75) as f32,
+                rng.range(0.0, std::f64::consts::TAU) as f32,
+            )
         };
         lights.push((
             cap(axis, rng.log_range(0.01, 0.5) as f32),

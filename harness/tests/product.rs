@@ -386,7 +386,10 @@ fn report_section_orders_tables_by_error() {
 fn curvature_fit_nan_exponents_and_overflowing_scales() {
     let alpha = 150f64.to_radians();
     let (a, b) = lobes(3.6e-35, 322.0, alpha);
-    for fit in [ProductFit::ExactIntegral, ProductFit::ExactIntegralCurvature] {
+    for fit in [
+        ProductFit::ExactIntegral,
+        ProductFit::ExactIntegralCurvature,
+    ] {
         let r = product::product_with(&ProductTable::builtin(), fit, &a, &b);
         assert!(
             r.exponent().is_finite() && r.scale().is_finite() && r.scale() >= 0.0,

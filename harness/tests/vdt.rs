@@ -489,7 +489,11 @@ fn report_section() {
     let opts = steradian_harness::report::Options::default();
     let t = std::time::Instant::now();
     let s = steradian_harness::report::vdt::section(&opts).unwrap();
-    println!("{}\n[section took {:.2} s]", s.summary, t.elapsed().as_secs_f64());
+    println!(
+        "{}\n[section took {:.2} s]",
+        s.summary,
+        t.elapsed().as_secs_f64()
+    );
     let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../target/vdt_section");
     std::fs::create_dir_all(&dir).unwrap();
     for (n, b) in &s.files {

@@ -9,6 +9,7 @@
 //! | [`lobe`] | [`lobe::integral`] | `integral_slices` | bit-identical |
 //! | [`lobe`] | [`lobe::eval`], [`lobe::eval_parts`] | `eval_slices` | within [`lobe::EVAL_REL_TOL`] |
 //! | [`cap`] | [`cap::exponent_l2`], [`cap::lookup`] | `exponent_l2_slices`, `lookup_slices` | bit-identical |
+//! | [`product`] | [`product::product_x8`] | `product_slices` | axis bit-identical; scale, exponent within [`product::SCALE_REL_TOL`] etc. |
 //!
 //! [`batch`] holds the lane types ([`Vec3x8`], [`Vec2x8`], [`LobeX8`]), their conversions
 //! from and to slices of the scalar types (a short slice is padded with a documented value),
@@ -78,6 +79,10 @@ pub mod batch;
 pub mod cap;
 pub mod hemisphere;
 pub mod lobe;
+pub mod product;
+pub mod sat;
+pub mod shade;
+pub mod vdt;
 
 mod lanes;
 

@@ -386,7 +386,11 @@ fn product_lanes<W: Lanes>(
         (scale * p, e_r, redo_in | (e_r * zero).is_nan())
     } else {
         let e_r = (W::splat(TAU.ln()) + base.ln_peak - ln_i).exp() - one;
-        (scale * exp_gradual(base.ln_peak), max_num(e_r, zero), redo_in)
+        (
+            scale * exp_gradual(base.ln_peak),
+            max_num(e_r, zero),
+            redo_in,
+        )
     };
     // Scalar: `ln I = −∞` (the baseline's `h` overflowed, or `α = π`, which the scalar
     // fallback handles) gives a zero-scale lobe of exponent 0.

@@ -11,6 +11,7 @@ use crate::kernels::{Columns, Kernel};
 
 pub mod cpu;
 pub mod gpu;
+pub mod gpu_product;
 pub mod simd;
 
 /// Why a backend could not run a batch.

@@ -2,8 +2,10 @@
 //! root solve for the cap-exponent optimum. Float functions come from the pure-Rust `libm`
 //! crate so results (and the generated tables) are the same on every machine.
 
+pub mod brdf;
 pub mod cap;
 pub mod product;
+pub mod triple;
 
 use std::f64::consts::{PI, TAU};
 

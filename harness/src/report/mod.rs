@@ -2,10 +2,16 @@
 //! against the f64 references on the default workload, written as `report.json`,
 //! `index.html` (tables and SVG speed-against-error plots) and a summary on stdout.
 
+pub mod brdf;
+pub mod lobe_sum;
 pub mod plot;
 pub mod product;
+pub mod rsl;
+pub mod sat;
 pub mod sections;
+pub mod shade;
 mod svg;
+pub mod vdt;
 
 use std::path::PathBuf;
 use std::time::{Duration, Instant};

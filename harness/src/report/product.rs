@@ -161,12 +161,28 @@ fn batch_speeds(
     gpu: bool,
 ) -> (f64, f64, Result<(f64, String), String>) {
     let n = lobes.len();
-    let col = |f: &dyn Fn(&(CosineLobe, CosineLobe)) -> f32| -> Vec<f32> { lobes.iter().map(f).collect() };
-    let a_axis = [col(&|l| l.0.axis().x), col(&|l| l.0.axis().y), col(&|l| l.0.axis().z)];
-    let b_axis = [col(&|l| l.1.axis().x), col(&|l| l.1.axis().y), col(&|l| l.1.axis().z)];
+    let col = |f: &dyn Fn(&(CosineLobe, CosineLobe)) -> f32| -> Vec<f32> {
+        lobes.iter().map(f).collect()
+    };
+    let a_axis = [
+        col(&|l| l.0.axis().x),
+        col(&|l| l.0.axis().y),
+        col(&|l| l.0.axis().z),
+    ];
+    let b_axis = [
+        col(&|l| l.1.axis().x),
+        col(&|l| l.1.axis().y),
+        col(&|l| l.1.axis().z),
+    ];
     let (a_s, a_e) = (col(&|l| l.0.scale()), col(&|l| l.0.exponent()));
     let (b_s, b_e) = (col(&|l| l.1.scale()), col(&|l| l.1.exponent()));
-    let mut out = [vec![0f32; n], vec![0f32; n], vec![0f32; n], vec![0f32; n], vec![0f32; n]];
+    let mut out = [
+        vec![0f32; n],
+        vec![0f32; n],
+        vec![0f32; n],
+        vec![0f32; n],
+        vec![0f32; n],
+    ];
     let table = ProductTable::builtin();
     let mut gpu_state = if gpu {
         crate::backend::gpu::try_gpu().map(|g| {
@@ -180,7 +196,18 @@ fn batch_speeds(
         .iter()
         .map(|(x, y)| {
             let (p, q) = (x.axis(), y.axis());
-            [p.x, p.y, p.z, x.scale(), x.exponent(), q.x, q.y, q.z, y.scale(), y.exponent()]
+            [
+                p.x,
+                p.y,
+                p.z,
+                x.scale(),
+                x.exponent(),
+                q.x,
+                q.y,
+                q.z,
+                y.scale(),
+                y.exponent(),
+            ]
         })
         .collect();
     let input = crate::kernels::Columns::from_rows(&rows);

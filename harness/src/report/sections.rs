@@ -30,7 +30,15 @@ pub struct Section {
 pub type Producer = fn(&Options) -> Result<Section, Box<dyn std::error::Error>>;
 
 /// Every section, in report order.
-pub const PRODUCERS: &[Producer] = &[super::product::section];
+pub const PRODUCERS: &[Producer] = &[
+    super::product::section,
+    super::sat::section,
+    super::brdf::section,
+    super::lobe_sum::section,
+    super::vdt::section,
+    super::rsl::section,
+    super::shade::section,
+];
 
 /// Runs every section producer.
 pub fn run_all(opts: &Options) -> Result<Vec<Section>, Box<dyn std::error::Error>> {
