@@ -5,6 +5,7 @@
 pub mod brdf;
 pub mod cap;
 pub mod product;
+pub mod quad;
 pub mod triple;
 
 use std::f64::consts::{PI, TAU};

@@ -41,6 +41,7 @@
 
 use std::f64::consts::{FRAC_PI_2, PI, TAU};
 
+use super::quad::gk15;
 use steradian_core::cap::SphericalCap;
 use steradian_core::lobe::CosineLobe;
 use steradian_core::lobe_sum::LobeTerms;
@@ -675,76 +676,7 @@ fn adapt(
     let (sum, err) = panels
         .iter()
         .fold((0.0, 0.0), |(s, e), p| (s + p.2, e + p.3));
-    if panels.len() > 1000 {
-        eprintln!(
-            "DBG {} panels sum {sum} err {err} rel {rel} abs {abs} pts {pts:?}",
-            panels.len()
-        );
-    }
     (sum, err, evals)
-}
-
-const XGK: [f64; 8] = [
-    0.991_455_371_120_812_6,
-    0.949_107_912_342_758_5,
-    0.864_864_423_359_769_1,
-    0.741_531_185_599_394_5,
-    0.586_087_235_467_691_1,
-    0.405_845_151_377_397_2,
-    0.207_784_955_007_898_48,
-    0.0,
-];
-const WGK: [f64; 8] = [
-    0.022_935_322_010_529_224,
-    0.063_092_092_629_978_56,
-    0.104_790_010_322_250_19,
-    0.140_653_259_715_525_92,
-    0.169_004_726_639_267_9,
-    0.190_350_578_064_785_42,
-    0.204_432_940_075_298_89,
-    0.209_482_141_084_727_82,
-];
-const WG: [f64; 4] = [
-    0.129_484_966_168_869_7,
-    0.279_705_391_489_276_64,
-    0.381_830_050_505_118_9,
-    0.417_959_183_673_469_4,
-];
-
-/// G7K15 on `[a, b]` with QUADPACK's error estimate.
-fn gk15(f: &mut dyn FnMut(f64) -> f64, a: f64, b: f64) -> (f64, f64) {
-    let c = 0.5 * (a + b);
-    let h = 0.5 * (b - a);
-    let fc = f(c);
-    let mut resk = WGK[7] * fc;
-    let mut resg = WG[3] * fc;
-    let mut resabs = (WGK[7] * fc).abs();
-    let mut fv = [(0.0, 0.0); 7];
-    for (j, slot) in fv.iter_mut().enumerate() {
-        let dx = h * XGK[j];
-        let (f1, f2) = (f(c - dx), f(c + dx));
-        *slot = (f1, f2);
-        resk += WGK[j] * (f1 + f2);
-        resabs += WGK[j] * (f1.abs() + f2.abs());
-        if j % 2 == 1 {
-            resg += WG[j / 2] * (f1 + f2);
-        }
-    }
-    let mean = 0.5 * resk;
-    let mut resasc = WGK[7] * (fc - mean).abs();
-    for (j, &(f1, f2)) in fv.iter().enumerate() {
-        resasc += WGK[j] * ((f1 - mean).abs() + (f2 - mean).abs());
-    }
-    let ah = h.abs();
-    let (resabs, resasc) = (resabs * ah, resasc * ah);
-    let mut err = ((resk - resg) * h).abs();
-    if resasc != 0.0 && err != 0.0 {
-        err = resasc * (200.0 * err / resasc).powf(1.5).min(1.0);
-    }
-    if resabs > f64::MIN_POSITIVE / (50.0 * f64::EPSILON) {
-        err = err.max(50.0 * f64::EPSILON * resabs);
-    }
-    (resk * h, err)
 }
 
 #[cfg(test)]
