@@ -27,33 +27,9 @@ impl Rng {
     }
 }
 
-/// Named special values put in every component and lane position.
-const SPECIALS: [f32; 24] = [
-    f32::NAN,
-    -f32::NAN,
-    f32::INFINITY,
-    f32::NEG_INFINITY,
-    0.0,
-    -0.0,
-    1e-40,  // subnormal
-    -1e-40, // subnormal
-    f32::MIN_POSITIVE,
-    1.0e-45, // smallest subnormal
-    f32::MAX,
-    -f32::MAX,
-    1e30,
-    -1e30,
-    1e-30,
-    -1e-30,
-    1.0,
-    -1.0,
-    1e-7,
-    -1e-7,
-    0.5,
-    0.70710677,
-    2.0,
-    3.0,
-];
+#[path = "common/specials.rs"]
+mod specials;
+use specials::SPECIALS;
 
 /// Bit-identical, or both NaN (payloads may differ).
 fn same(a: f32, b: f32) -> bool {

@@ -266,31 +266,9 @@ fn survey_max_differences_long() {
 // ---------------------------------------------------------------------------------------
 // Named cases
 
-/// Named special values for every field.
-const SPECIALS: [f32; 22] = [
-    f32::NAN,
-    -f32::NAN,
-    f32::INFINITY,
-    f32::NEG_INFINITY,
-    0.0,
-    -0.0,
-    1e-40,   // subnormal
-    -1e-40,  // subnormal
-    1.0e-45, // smallest subnormal
-    f32::MIN_POSITIVE,
-    f32::MAX,
-    -f32::MAX,
-    1e30,
-    1e-30,
-    1.0,
-    -1.0,
-    1e-7,
-    0.5,
-    2.0,
-    1e5,
-    1e-3,
-    3e38,
-];
+#[path = "common/specials.rs"]
+mod specials;
+use specials::SPECIALS;
 
 /// A batch of 8 ordinary pairs from `rng`.
 fn ordinary(rng: &mut Rng) -> ([Raw; 8], [Raw; 8]) {
