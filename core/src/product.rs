@@ -371,20 +371,6 @@ pub fn baseline(e1: f32, e2: f32, cos_a: f32, sin_a: f32) -> Baseline {
     }
 }
 
-/// `ln I(e1, e2, α)` for unit lobes from `table`: `ln B + g`. `−∞` at `α = π`.
-#[inline]
-pub fn ln_integral(table: &ProductTable<'_>, e1: f32, e2: f32, cos_a: f32, sin_a: f32) -> f32 {
-    let b = baseline(e1, e2, cos_a, sin_a);
-    b.ln_b + table.correction(exponent_coord(e1), exponent_coord(e2), b.w)
-}
-
-/// The angle between two unit axes, `atan2(|a×b|, a·b)`: accurate at 0 and near π, where
-/// `acos(a·b)` loses half the digits.
-#[inline]
-pub fn angle_between(a: Vec3, b: Vec3) -> f32 {
-    math::atan2f(a.cross(b).length(), a.dot(b))
-}
-
 /// `(cos α, sin α, w)` of two unit axes, `w` the unit vector perpendicular to `a1` in the
 /// plane of both, toward `a2` (a fixed perpendicular of `a1` when the axes are
 /// (anti)parallel).
@@ -502,15 +488,4 @@ pub fn product_with(
     // 2π·peak/(e_r + 1) = I.
     let e_r = math::expf(LN_TWO_PI + base.ln_peak - ln_i) - 1.0;
     CosineLobe::saturating(axis, scaled(base.ln_peak), e_r.max(0.0))
-}
-
-/// The spherical-Gaussian closed form with the exact peak (no table). See
-/// [`ProductFit::SphericalGaussian`].
-pub fn product_sg(a: &CosineLobe, b: &CosineLobe) -> CosineLobe {
-    product_with(
-        &ProductTable::builtin(),
-        ProductFit::SphericalGaussian,
-        a,
-        b,
-    )
 }

@@ -70,7 +70,8 @@ fn finite_f32(v: &Value, name: &str) -> Result<f32, String> {
     Ok(f)
 }
 
-fn number(obj: &Map<String, Value>, name: &str) -> Result<f32, String> {
+/// Field `name` of `obj` as a finite f32, or the error message for the line.
+pub(crate) fn number(obj: &Map<String, Value>, name: &str) -> Result<f32, String> {
     finite_f32(field(obj, name)?, name)
 }
 

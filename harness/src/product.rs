@@ -7,7 +7,7 @@ use steradian_core::lobe::CosineLobe;
 use steradian_core::product;
 use steradian_core::{TWO_PI, Vec3};
 
-use crate::eval::num;
+use crate::eval::{num, number};
 
 /// Unit lobes in the canonical configuration.
 pub fn canonical_lobes(e1: f32, e2: f32, alpha: f32) -> (CosineLobe, CosineLobe) {
@@ -18,26 +18,16 @@ pub fn canonical_lobes(e1: f32, e2: f32, alpha: f32) -> (CosineLobe, CosineLobe)
     )
 }
 
-fn field(obj: &Map<String, Value>, name: &str) -> Result<f32, String> {
-    let v = obj
-        .get(name)
-        .ok_or_else(|| format!("missing field \"{name}\""))?;
-    let x = v
-        .as_f64()
-        .ok_or_else(|| format!("field \"{name}\" must be a number"))?;
-    let f = x as f32;
-    if !f.is_finite() {
-        return Err(format!("field \"{name}\" = {x} is not a finite f32"));
-    }
-    Ok(f)
-}
-
 /// `{"e1", "e2", "alpha"}` → `{"scale", "exponent", "axis_angle", "integral"}` for unit
 /// lobes in the canonical configuration (built-in table, exact-integral fit).
 /// `e1, e2 ∈ [0, 1e5]` (beyond, the table's last row is used; accepted up to 1e7) and
 /// `alpha ∈ [0, π]`.
 pub fn eval_lobe_product(obj: &Map<String, Value>) -> Result<Value, String> {
-    let (e1, e2, alpha) = (field(obj, "e1")?, field(obj, "e2")?, field(obj, "alpha")?);
+    let (e1, e2, alpha) = (
+        number(obj, "e1")?,
+        number(obj, "e2")?,
+        number(obj, "alpha")?,
+    );
     for (name, e) in [("e1", e1), ("e2", e2)] {
         if !(0.0..=1e7).contains(&e) {
             return Err(format!("{name} = {e} is outside [0, 1e7]"));

@@ -142,16 +142,17 @@ pub fn values(exponents: usize, angles: usize, progress: &dyn Fn(usize, usize)) 
     out
 }
 
-/// The complete built-in table file.
-pub fn generate() -> Vec<u8> {
-    let values = values(TABLE_EXPONENTS, TABLE_ANGLES, &|_, _| {});
+/// A complete table file of `exponents × angles` samples (the built-in one is
+/// `TABLE_EXPONENTS × TABLE_ANGLES`; the report generates smaller ones).
+pub fn encode(exponents: usize, angles: usize) -> Vec<u8> {
+    let values = values(exponents, angles, &|_, _| {});
     let spec = Spec {
         name: TABLE_NAME,
         rank: 2,
         channels: 1,
         dims: [
-            (TABLE_EXPONENTS * (TABLE_EXPONENTS + 1) / 2) as u32,
-            TABLE_ANGLES as u32,
+            (exponents * (exponents + 1) / 2) as u32,
+            angles as u32,
             1,
             1,
         ],
@@ -161,4 +162,9 @@ pub fn generate() -> Vec<u8> {
     let mut out = vec![0u8; HEADER_LEN + 4 * values.len()];
     encode_into(&spec, &values, &mut out).expect("sizes agree by construction");
     out
+}
+
+/// The complete built-in table file.
+pub fn generate() -> Vec<u8> {
+    encode(TABLE_EXPONENTS, TABLE_ANGLES)
 }

@@ -27,6 +27,7 @@ use steradian_core::lobe_sum::{
 use steradian_core::product::{self, ProductFit, ProductTable};
 
 use super::Options;
+use super::plot::{Pt, Scale, Series, chart};
 use super::sections::Section;
 use crate::reference::triple::{self as reference, Cap, Lobe, Scene, Term, Visibility};
 use crate::rng::Rng;
@@ -54,7 +55,6 @@ struct Curve {
     name: &'static str,
     fit: ProductFit,
     cosine: Cosine,
-    color: &'static str,
 }
 
 const CURVES: [Curve; 4] = [
@@ -62,25 +62,21 @@ const CURVES: [Curve; 4] = [
         name: "exact integral, cos on light",
         fit: ProductFit::ExactIntegral,
         cosine: Cosine::WithLight,
-        color: "#1f77b4",
     },
     Curve {
         name: "exact integral + curvature, cos on light",
         fit: ProductFit::ExactIntegralCurvature,
         cosine: Cosine::WithLight,
-        color: "#2ca02c",
     },
     Curve {
         name: "SG closed form, cos on light",
         fit: ProductFit::SphericalGaussian,
         cosine: Cosine::WithLight,
-        color: "#d62728",
     },
     Curve {
         name: "exact integral, cos on BRDF",
         fit: ProductFit::ExactIntegral,
         cosine: Cosine::WithBrdf,
-        color: "#ff7f0e",
     },
 ];
 
@@ -336,90 +332,29 @@ pub fn section(_opts: &Options) -> Result<Section, Box<dyn Error>> {
     })
 }
 
-/// Max error (log y) against products per point (x), one polyline per curve.
+/// Max error (log y) against products per point (x), one line per curve, a point per
+/// threshold.
 fn plot(rows: &[Row]) -> String {
-    const FLOOR: f64 = 1e-8;
-    let (w, h, l, t, pw, ph) = (720.0, 420.0, 70.0, 20.0, 600.0, 330.0);
-    let xmax = rows.iter().map(|r| r.products).fold(1.0, f64::max).ceil();
-    let ys: Vec<f64> = rows.iter().map(|r| r.err_max.max(FLOOR).log10()).collect();
-    let y0 = ys.iter().copied().fold(f64::INFINITY, f64::min).floor();
-    let y1 = ys
+    let series: Vec<Series> = CURVES
         .iter()
-        .copied()
-        .fold(f64::NEG_INFINITY, f64::max)
-        .ceil()
-        .max(y0 + 1.0);
-    let px = |x: f64| l + x / xmax * pw;
-    let py = |y: f64| t + (y1 - y) / (y1 - y0) * ph;
-    let mut s = format!(
-        r##"<svg xmlns="http://www.w3.org/2000/svg" width="{w}" height="{h}" viewBox="0 0 {w} {h}" font-family="sans-serif" font-size="11">
-<rect width="100%" height="100%" fill="white"/>
-<rect x="{l}" y="{t}" width="{pw}" height="{ph}" fill="none" stroke="#999"/>
-<text x="{}" y="{}" text-anchor="middle" fill="#555">products computed per point</text>
-<text transform="translate(14,{}) rotate(-90)" text-anchor="middle" fill="#555">max error / brightest value</text>
-"##,
-        l + pw / 2.0,
-        t + ph + 30.0,
-        t + ph / 2.0
-    );
-    let mut y = y0;
-    while y <= y1 + 1e-9 {
-        s += &format!(
-            r##"<text x="{}" y="{}" text-anchor="end" fill="#555">1e{}</text><line x1="{l}" x2="{}" y1="{}" y2="{}" stroke="#eee"/>
-"##,
-            l - 4.0,
-            py(y) + 4.0,
-            y as i32,
-            l + pw,
-            py(y),
-            py(y)
-        );
-        y += 1.0;
-    }
-    for k in 0..=4 {
-        let x = xmax * k as f64 / 4.0;
-        s += &format!(
-            r##"<text x="{}" y="{}" text-anchor="middle" fill="#555">{x:.0}</text>
-"##,
-            px(x),
-            t + ph + 14.0
-        );
-    }
-    for (ci, c) in CURVES.iter().enumerate() {
-        let pts: Vec<(f64, f64, f64)> = rows
-            .iter()
-            .filter(|r| r.curve == ci)
-            .map(|r| (px(r.products), py(r.err_max.max(FLOOR).log10()), r.t))
-            .collect();
-        let line: Vec<String> = pts
-            .iter()
-            .map(|(x, y, _)| format!("{x:.1},{y:.1}"))
-            .collect();
-        s += &format!(
-            r#"<polyline points="{}" fill="none" stroke="{}" stroke-width="{}"/>
-"#,
-            line.join(" "),
-            c.color,
-            // The first curve is drawn wide so that curves on top of it stay visible.
-            if ci == 0 { 4.0 } else { 1.5 }
-        );
-        for (x, y, tt) in &pts {
-            s += &format!(
-                r#"<circle cx="{x:.1}" cy="{y:.1}" r="3.5" fill="{}"><title>{}: t = {tt:.0e}</title></circle>
-"#,
-                c.color, c.name
-            );
-        }
-        s += &format!(
-            r#"<circle cx="{}" cy="{}" r="4" fill="{}"/><text x="{}" y="{}">{}</text>
-"#,
-            l + 10.0 + (ci % 2) as f64 * 300.0,
-            h - 28.0 + (ci / 2) as f64 * 14.0,
-            c.color,
-            l + 18.0 + (ci % 2) as f64 * 300.0,
-            h - 24.0 + (ci / 2) as f64 * 14.0,
-            c.name
-        );
-    }
-    s + "</svg>\n"
+        .enumerate()
+        .map(|(ci, c)| Series {
+            label: c.name.into(),
+            points: rows
+                .iter()
+                .filter(|r| r.curve == ci)
+                .map(|r| Pt {
+                    note: Some(format!("{}: t = {:.0e}", c.name, r.t)),
+                    ..Pt::new(r.products, r.err_max)
+                })
+                .collect(),
+            line: true,
+        })
+        .collect();
+    chart(
+        "Lobe sums: error against products computed (pruning threshold t)",
+        ("products computed per point", Scale::Linear),
+        ("max error / brightest value", Scale::Log),
+        &series,
+    )
 }

@@ -1,19 +1,55 @@
-//! A small log-log scatter plot in SVG for the report sections: one labelled point per
-//! configuration, with an optional bar up to a second value (e.g. mean to max).
+//! A small SVG chart for the report sections: named series of points on linear or log
+//! axes, optionally joined by a line, each point optionally with a vertical bar up to a
+//! second value (e.g. mean to max) and a tooltip.
 
 use std::fmt::Write as _;
 
-/// One point of a [`log_log`] plot.
+/// How an axis maps values.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Scale {
+    /// Linear from 0.
+    Linear,
+    /// Decades; values at or below [`FLOOR`] are drawn on the floor.
+    Log,
+}
+
+/// Values at or below this are drawn on a log axis's floor (an exact result).
+pub const FLOOR: f64 = 1e-12;
+
+/// One point of a [`Series`].
 #[derive(Clone, Debug)]
-pub struct Point {
-    /// Label drawn beside the point.
-    pub label: String,
-    /// x (> 0).
+pub struct Pt {
+    /// x.
     pub x: f64,
-    /// y (> 0; smaller values are drawn on the floor).
+    /// y.
     pub y: f64,
     /// Optional upper end of a vertical bar from `y`.
     pub y_hi: Option<f64>,
+    /// Optional tooltip.
+    pub note: Option<String>,
+}
+
+impl Pt {
+    /// A plain point.
+    pub fn new(x: f64, y: f64) -> Self {
+        Pt {
+            x,
+            y,
+            y_hi: None,
+            note: None,
+        }
+    }
+}
+
+/// A named series, drawn in one colour.
+#[derive(Clone, Debug)]
+pub struct Series {
+    /// Legend entry.
+    pub label: String,
+    /// Its points (non-finite ones are skipped).
+    pub points: Vec<Pt>,
+    /// Join the points with a line.
+    pub line: bool,
 }
 
 const COLORS: [&str; 8] = [
@@ -26,36 +62,89 @@ fn esc(s: &str) -> String {
         .replace('>', "&gt;")
 }
 
-/// A complete SVG document: log axes with decade ticks, one colour per point, a legend.
-pub fn log_log(title: &str, x_label: &str, y_label: &str, points: &[Point]) -> String {
-    const FLOOR: f64 = 1e-12;
-    let (w, h) = (720.0, 420.0);
-    let (left, right, top, bottom) = (80.0, 250.0, 40.0, 60.0);
-    let finite = |v: f64| v.is_finite() && v > 0.0;
-    let xs: Vec<f64> = points.iter().map(|p| p.x).filter(|&v| finite(v)).collect();
-    let ys: Vec<f64> = points
-        .iter()
-        .flat_map(|p| [Some(p.y), p.y_hi])
-        .flatten()
-        .map(|v| v.max(FLOOR))
-        .filter(|&v| finite(v))
-        .collect();
-    let span = |v: &[f64]| {
-        let lo = v.iter().cloned().fold(f64::INFINITY, f64::min);
-        let hi = v.iter().cloned().fold(f64::NEG_INFINITY, f64::max);
-        if lo.is_finite() && hi.is_finite() {
-            (
-                (lo.log10()).floor(),
-                (hi.log10()).ceil().max(lo.log10().floor() + 1.0),
-            )
-        } else {
-            (0.0, 1.0)
+/// An axis: value → `[0, 1]` of the plot area, and its tick values with labels.
+struct Axis {
+    scale: Scale,
+    lo: f64,
+    hi: f64,
+}
+
+impl Axis {
+    fn new(scale: Scale, values: impl Iterator<Item = f64>) -> Axis {
+        let t = |v: f64| match scale {
+            Scale::Linear => v,
+            Scale::Log => v.max(FLOOR).log10(),
+        };
+        let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
+        for v in values.filter(|v| v.is_finite() && (scale == Scale::Linear || *v > 0.0)) {
+            lo = lo.min(t(v));
+            hi = hi.max(t(v));
         }
-    };
-    let (x0, x1) = span(&xs);
-    let (y0, y1) = span(&ys);
-    let px = |x: f64| left + (x.log10() - x0) / (x1 - x0) * (w - left - right);
-    let py = |y: f64| h - bottom - (y.max(FLOOR).log10() - y0) / (y1 - y0) * (h - top - bottom);
+        if !lo.is_finite() {
+            (lo, hi) = (0.0, 1.0);
+        }
+        match scale {
+            Scale::Linear => Axis {
+                scale,
+                lo: lo.min(0.0),
+                hi: if hi > lo.min(0.0) {
+                    hi
+                } else {
+                    lo.min(0.0) + 1.0
+                },
+            },
+            Scale::Log => Axis {
+                scale,
+                lo: lo.floor(),
+                hi: hi.ceil().max(lo.floor() + 1.0),
+            },
+        }
+    }
+
+    fn frac(&self, v: f64) -> f64 {
+        let t = match self.scale {
+            Scale::Linear => v,
+            Scale::Log => v.max(FLOOR).log10(),
+        };
+        (t - self.lo) / (self.hi - self.lo)
+    }
+
+    fn ticks(&self) -> Vec<(f64, String)> {
+        match self.scale {
+            Scale::Log => {
+                let mut d = self.lo;
+                let mut out = Vec::new();
+                while d <= self.hi + 1e-9 {
+                    out.push((10f64.powf(d), format!("1e{d}")));
+                    d += 1.0;
+                }
+                out
+            }
+            Scale::Linear => (0..=4)
+                .map(|k| {
+                    let v = self.lo + (self.hi - self.lo) * k as f64 / 4.0;
+                    let digits = if self.hi - self.lo >= 10.0 { 0 } else { 3 };
+                    (v, format!("{v:.digits$}"))
+                })
+                .collect(),
+        }
+    }
+}
+
+/// A complete SVG document: the axes with ticks, one colour per series, a legend.
+pub fn chart(
+    title: &str,
+    (x_label, x_scale): (&str, Scale),
+    (y_label, y_scale): (&str, Scale),
+    series: &[Series],
+) -> String {
+    let (w, h) = (800.0, 420.0);
+    let (left, right, top, bottom) = (80.0, 330.0, 40.0, 60.0);
+    let all = || series.iter().flat_map(|s| s.points.iter());
+    let xa = Axis::new(x_scale, all().map(|p| p.x));
+    let ya = Axis::new(y_scale, all().flat_map(|p| [Some(p.y), p.y_hi]).flatten());
+    let px = |x: f64| left + xa.frac(x) * (w - left - right);
+    let py = |y: f64| h - bottom - ya.frac(y) * (h - top - bottom);
     let mut s = format!(
         r#"<svg xmlns="http://www.w3.org/2000/svg" width="{w}" height="{h}" viewBox="0 0 {w} {h}" font-family="sans-serif" font-size="12">
 <rect width="{w}" height="{h}" fill="white"/>
@@ -64,35 +153,30 @@ pub fn log_log(title: &str, x_label: &str, y_label: &str, points: &[Point]) -> S
         (w - right + left) / 2.0,
         esc(title)
     );
-    // Axes and decade ticks.
     let _ = writeln!(
         s,
         r##"<rect x="{left}" y="{top}" width="{}" height="{}" fill="none" stroke="#444"/>"##,
         w - left - right,
         h - top - bottom
     );
-    let mut d = x0;
-    while d <= x1 + 1e-9 {
-        let x = px(10f64.powf(d));
+    for (v, label) in xa.ticks() {
+        let x = px(v);
         let _ = writeln!(
             s,
-            r##"<line x1="{x}" y1="{}" x2="{x}" y2="{top}" stroke="#ddd"/><text x="{x}" y="{}" text-anchor="middle">1e{d}</text>"##,
+            r##"<line x1="{x}" y1="{}" x2="{x}" y2="{top}" stroke="#ddd"/><text x="{x}" y="{}" text-anchor="middle">{label}</text>"##,
             h - bottom,
             h - bottom + 16.0
         );
-        d += 1.0;
     }
-    let mut d = y0;
-    while d <= y1 + 1e-9 {
-        let y = py(10f64.powf(d));
+    for (v, label) in ya.ticks() {
+        let y = py(v);
         let _ = writeln!(
             s,
-            r##"<line x1="{left}" y1="{y}" x2="{}" y2="{y}" stroke="#ddd"/><text x="{}" y="{}" text-anchor="end">1e{d}</text>"##,
+            r##"<line x1="{left}" y1="{y}" x2="{}" y2="{y}" stroke="#ddd"/><text x="{}" y="{}" text-anchor="end">{label}</text>"##,
             w - right,
             left - 6.0,
             y + 4.0
         );
-        d += 1.0;
     }
     let _ = writeln!(
         s,
@@ -108,20 +192,46 @@ pub fn log_log(title: &str, x_label: &str, y_label: &str, points: &[Point]) -> S
         (h - bottom + top) / 2.0,
         esc(y_label)
     );
-    for (i, p) in points.iter().enumerate() {
-        if !finite(p.x) {
-            continue;
-        }
+    let ok = |v: f64, scale: Scale| v.is_finite() && (scale == Scale::Linear || v > 0.0);
+    for (i, ser) in series.iter().enumerate() {
         let c = COLORS[i % COLORS.len()];
-        let (x, y) = (px(p.x), py(p.y));
-        if let Some(hi) = p.y_hi {
+        let pts: Vec<&Pt> = ser
+            .points
+            .iter()
+            .filter(|p| ok(p.x, x_scale) && p.y.is_finite())
+            .collect();
+        if ser.line && pts.len() > 1 {
+            let line: Vec<String> = pts
+                .iter()
+                .map(|p| format!("{:.1},{:.1}", px(p.x), py(p.y)))
+                .collect();
             let _ = writeln!(
                 s,
-                r#"<line x1="{x}" y1="{y}" x2="{x}" y2="{}" stroke="{c}" stroke-width="2"/>"#,
-                py(hi)
+                r#"<polyline points="{}" fill="none" stroke="{c}" stroke-width="{}"/>"#,
+                line.join(" "),
+                // Earlier series are drawn wider, so that series on top of them stay visible.
+                1.5 + 2.5 * (series.len() - 1 - i) as f64 / series.len().max(1) as f64
             );
         }
-        let _ = writeln!(s, r#"<circle cx="{x}" cy="{y}" r="5" fill="{c}"/>"#);
+        for p in pts {
+            let (x, y) = (px(p.x), py(p.y));
+            if let Some(hi) = p.y_hi.filter(|v| v.is_finite()) {
+                let _ = writeln!(
+                    s,
+                    r#"<line x1="{x}" y1="{y}" x2="{x}" y2="{}" stroke="{c}" stroke-width="2"/>"#,
+                    py(hi)
+                );
+            }
+            let tip = p
+                .note
+                .as_deref()
+                .map_or(String::new(), |n| format!("<title>{}</title>", esc(n)));
+            let _ = writeln!(
+                s,
+                r#"<circle cx="{x:.1}" cy="{y:.1}" r="{}" fill="{c}">{tip}</circle>"#,
+                3.5 + 2.0 * (series.len() - 1 - i) as f64 / series.len().max(1) as f64
+            );
+        }
         let ly = top + 16.0 + 18.0 * i as f64;
         let _ = writeln!(
             s,
@@ -130,7 +240,7 @@ pub fn log_log(title: &str, x_label: &str, y_label: &str, points: &[Point]) -> S
             ly - 4.0,
             w - right + 26.0,
             ly,
-            esc(&p.label)
+            esc(&ser.label)
         );
     }
     s += "</svg>\n";

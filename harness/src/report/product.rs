@@ -12,11 +12,10 @@ use std::time::{Duration, Instant};
 use indicatif::{ProgressBar, ProgressStyle};
 use serde_json::json;
 use steradian_core::lobe::CosineLobe;
-use steradian_core::product::{self, ProductFit, ProductTable, TABLE_NAME};
-use steradian_core::table::{HEADER_LEN, Spec, encode_into};
+use steradian_core::product::{self, ProductFit, ProductTable};
 
 use super::Options;
-use super::plot::{Point, log_log};
+use super::plot::{Pt, Scale, Series, chart};
 use super::sections::Section;
 use crate::generate::lobe_product;
 use crate::product::canonical_lobes;
@@ -43,27 +42,6 @@ pub fn exponent(rng: &mut Rng) -> f32 {
     } else {
         rng.log_range(1e-3, 1e5) as f32
     }
-}
-
-/// A table of another resolution, encoded like the built-in one.
-pub fn table_bytes(exponents: usize, angles: usize) -> Vec<u8> {
-    let values = lobe_product::values(exponents, angles, &|_, _| {});
-    let spec = Spec {
-        name: TABLE_NAME,
-        rank: 2,
-        channels: 1,
-        dims: [
-            (exponents * (exponents + 1) / 2) as u32,
-            angles as u32,
-            1,
-            1,
-        ],
-        lo: [0.0; 4],
-        hi: [1e5, 1.0, 1.0, 1.0],
-    };
-    let mut out = vec![0u8; HEADER_LEN + 4 * values.len()];
-    encode_into(&spec, &values, &mut out).expect("sizes agree");
-    out
 }
 
 /// Relative errors of the result's integral where `I ≥ 1e−6·min(∫c1, ∫c2)`.
@@ -192,25 +170,7 @@ fn batch_speeds(
     } else {
         Err("--no-gpu".to_string())
     };
-    let rows: Vec<[f32; 10]> = lobes
-        .iter()
-        .map(|(x, y)| {
-            let (p, q) = (x.axis(), y.axis());
-            [
-                p.x,
-                p.y,
-                p.z,
-                x.scale(),
-                x.exponent(),
-                q.x,
-                q.y,
-                q.z,
-                y.scale(),
-                y.exponent(),
-            ]
-        })
-        .collect();
-    let input = crate::kernels::Columns::from_rows(&rows);
+    let input = crate::backend::gpu_product::lobe_product_input(lobes.iter().map(|(x, y)| (x, y)));
     let mut gout = crate::kernels::Columns::zeros(5, n);
     let gtable = crate::backend::gpu_product::ProductGpuTable::builtin();
     let mut scalar_out = vec![lobes[0].0; n];
@@ -294,7 +254,7 @@ pub fn section(opts: &Options) -> Result<Section, Box<dyn Error>> {
     for (ne, nw) in RESOLUTIONS {
         bar.set_message(format!("lobe products: generating a {ne}×{ne}×{nw} table"));
         let t = Instant::now();
-        let bytes = table_bytes(ne, nw);
+        let bytes = lobe_product::encode(ne, nw);
         owned.push((format!("{ne}×{ne}×{nw} table"), bytes, t.elapsed()));
         bar.inc(1);
     }
@@ -473,11 +433,13 @@ pub fn section(opts: &Options) -> Result<Section, Box<dyn Error>> {
             p99,
             mx
         );
-        points_svg.push(Point {
+        points_svg.push(Series {
             label: r.name.clone(),
-            x: r.per_s,
-            y: m,
-            y_hi: Some(mx),
+            points: vec![Pt {
+                y_hi: Some(mx),
+                ..Pt::new(r.per_s, m)
+            }],
+            line: false,
         });
         json_rows.push(json!({
             "name": r.name, "bytes": r.bytes, "products_per_s": r.per_s,
@@ -587,10 +549,13 @@ pub fn section(opts: &Options) -> Result<Section, Box<dyn Error>> {
     }
     html += "</table>\n";
 
-    let svg = log_log(
+    let svg = chart(
         "Lobe product: scalar speed against integral error",
-        "products per second (one core)",
-        "relative integral error (dot: mean, bar to max)",
+        ("products per second (one core)", Scale::Log),
+        (
+            "relative integral error (dot: mean, bar to max)",
+            Scale::Log,
+        ),
         &points_svg,
     );
     Ok(Section {
