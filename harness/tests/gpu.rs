@@ -6,37 +6,18 @@
 //! Without an adapter the tests print `GPU tests skipped: <reason>` and pass, unless
 //! `STERADIAN_REQUIRE_GPU=1`, in which case they fail.
 
-use std::io::Write;
 use std::time::Instant;
 
-/// Writes straight to stderr: the test harness captures `eprintln!` of passing tests, and
-/// which adapter ran (or why none did) must show in every test run.
-fn say(line: &str) {
-    let _ = writeln!(std::io::stderr(), "{line}");
-}
-
 use steradian_core::wgsl;
-use steradian_harness::backend::gpu::{Gpu, gpu_required, try_gpu};
+use steradian_harness::backend::gpu::Gpu;
 use steradian_harness::backend::{Backend, cpu};
 use steradian_harness::kernels::{Columns, Kernel};
 
 use core::f32::consts::{FRAC_PI_2, PI};
 
-fn gpu() -> Option<Gpu> {
-    match try_gpu() {
-        Ok(g) => {
-            say(&format!("GPU tests ran on adapter: {}", g.adapter_info()));
-            Some(g)
-        }
-        Err(reason) => {
-            if gpu_required() {
-                panic!("STERADIAN_REQUIRE_GPU=1 but no GPU backend: {reason}");
-            }
-            say(&format!("GPU tests skipped: {reason}"));
-            None
-        }
-    }
-}
+#[path = "common/gpu.rs"]
+mod gpu_common;
+use gpu_common::gpu;
 
 /// The harness's deterministic generator, with the f32 helpers these tests want.
 struct Rng(steradian_harness::rng::Rng);

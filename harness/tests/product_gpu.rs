@@ -6,31 +6,15 @@
 use steradian_core::lobe::CosineLobe;
 use steradian_core::product::{self, ProductFit, ProductTable};
 use steradian_core::{Vec3, wgsl};
-use steradian_harness::backend::gpu::{Gpu, gpu_required, try_gpu};
+use steradian_harness::backend::gpu::Gpu;
 use steradian_harness::backend::gpu_product::{
     ProductGpuTable, run_lobe_product_columns, run_lobe_product_gpu,
 };
 use steradian_harness::kernels::Columns;
 
-fn say(msg: &str) {
-    eprintln!("{msg}");
-}
-
-fn gpu() -> Option<Gpu> {
-    match try_gpu() {
-        Ok(g) => {
-            say(&format!("GPU tests ran on adapter: {}", g.adapter_info()));
-            Some(g)
-        }
-        Err(reason) => {
-            if gpu_required() {
-                panic!("STERADIAN_REQUIRE_GPU=1 but no GPU backend: {reason}");
-            }
-            say(&format!("GPU tests skipped: {reason}"));
-            None
-        }
-    }
-}
+#[path = "common/gpu.rs"]
+mod gpu_common;
+use gpu_common::{gpu, say};
 
 /// The harness's deterministic generator, with the f32 helpers these tests want.
 struct Rng(steradian_harness::rng::Rng);

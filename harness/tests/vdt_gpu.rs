@@ -4,34 +4,16 @@
 //! Without an adapter the GPU test prints `GPU tests skipped: <reason>` and passes, unless
 //! `STERADIAN_REQUIRE_GPU=1`, in which case it fails.
 
-use std::io::Write;
-
 use naga::valid::{Capabilities, ValidationFlags, Validator};
 use steradian_core::vdt::Vdt;
 use steradian_core::wgsl;
-use steradian_harness::backend::gpu::{Custom, Gpu, gpu_required, try_gpu};
+use steradian_harness::backend::gpu::Custom;
 use steradian_harness::kernels::Columns;
 use steradian_harness::rng::Rng;
 
-fn say(line: &str) {
-    let _ = writeln!(std::io::stderr(), "{line}");
-}
-
-fn gpu() -> Option<Gpu> {
-    match try_gpu() {
-        Ok(g) => {
-            say(&format!("GPU tests ran on adapter: {}", g.adapter_info()));
-            Some(g)
-        }
-        Err(reason) => {
-            if gpu_required() {
-                panic!("STERADIAN_REQUIRE_GPU=1 but no GPU backend: {reason}");
-            }
-            say(&format!("GPU tests skipped: {reason}"));
-            None
-        }
-    }
-}
+#[path = "common/gpu.rs"]
+mod gpu_common;
+use gpu_common::{gpu, say};
 
 #[test]
 fn vdt_query_wgsl_validates() {

@@ -6,47 +6,18 @@
 // [ax, ay, az, scale, exponent]; column c of a batch of n rows at c*n. The table at binding
 // 3 is [exponents, angles, g...]: the two sizes as f32, then the g values in the packed
 // layout of `ProductTable` (pairs i <= j at j(j+1)/2 + i, each followed by its angles).
-// Specified for finite inputs only; see `steradian_core::wgsl`.
+// Specified for finite inputs only; see `steradian_core::wgsl`. `log1p` and `ln_` (log
+// without WGSL's `log`) are those of log1p.wgsl (concatenated before this file by `wgsl.rs`).
 
 @group(0) @binding(3) var<storage, read> table: array<f32>;
 
 const TWO_PI: f32 = 6.2831855;
 // ln(2*pi) as the f32 the scalar kernel computes.
 const LN_TWO_PI: f32 = 1.837877;
-const LN2: f32 = 0.6931471805599453;
 // `product::EXPONENT_EPS`, `1/ln(1 + E/eps)`, `product::ANGLE_LOG_DROP`.
 const EXPONENT_EPS: f32 = 0.05;
 const INV_LN_SPAN: f32 = 0.06892436;
 const ANGLE_LOG_DROP: f32 = 30.0;
-
-// log(1 + x) without `log` (WGSL's is only 2^-21 absolute near 1): 2·atanh(w) by its odd
-// series for 1 + x in [sqrt(1/2), sqrt(2)), else k·ln2 + log(m) with 1 + x = 2^k·m (as in
-// the lobe-eval kernel).
-fn log1p_atanh(w: f32) -> f32 {
-    let w2 = w * w;
-    let p = 1.0 / 3.0 + w2 * (1.0 / 5.0 + w2 * (1.0 / 7.0 + w2 * (1.0 / 9.0 + w2 * (1.0 / 11.0))));
-    return 2.0 * w + 2.0 * w * (w2 * p);
-}
-
-fn log1p_(x: f32) -> f32 {
-    if (x >= -0.29289323 && x < 0.41421357) {
-        return log1p_atanh(x / (2.0 + x));
-    }
-    return ln_(1.0 + x);
-}
-
-// ln(x) for x > 0 (normal): k·ln2 + 2·atanh((m − 1)/(m + 1)), x = 2^k·m, m in
-// [sqrt(1/2), sqrt(2)); m − 1 is exact, so the result keeps its relative precision near 1.
-fn ln_(x: f32) -> f32 {
-    let fr = frexp(x);
-    var m = fr.fract;
-    var k = fr.exp;
-    if (m < 0.70710677) {
-        m = 2.0 * m;
-        k = k - 1;
-    }
-    return f32(k) * LN2 + log1p_atanh((m - 1.0) / (m + 1.0));
-}
 
 // atan2(y, x) for y >= 0 (Cephes' atanf polynomial after reduction to [0, tan(π/8)]):
 // full relative precision for small results, which WGSL's atan2 does not promise.
@@ -110,13 +81,13 @@ fn ratio(f1: f32, f2: f32) -> vec2<f32> {
 // ln cos t from (1 − cos 2t, 1 + cos 2t).
 fn ln_cos_half(omc: f32, opc: f32) -> f32 {
     if (omc < opc) {
-        return 0.5 * log1p_(-0.5 * omc);
+        return 0.5 * log1p(-0.5 * omc);
     }
     return 0.5 * ln_(0.5 * opc);
 }
 
 fn exponent_coord(e: f32) -> f32 {
-    return min(log1p_(max(e, 0.0) / EXPONENT_EPS) * INV_LN_SPAN, 1.0);
+    return min(log1p(max(e, 0.0) / EXPONENT_EPS) * INV_LN_SPAN, 1.0);
 }
 
 // The table value of pair (a, b) at angle node k, and the next one.

@@ -44,6 +44,32 @@ impl ProductGpuTable {
     }
 }
 
+/// The 10 input columns `[a1x, a1y, a1z, s1, e1, a2x, a2y, a2z, s2, e2]` of
+/// [`wgsl::LOBE_PRODUCT`] for the pairs `(a, b)`, one row per pair.
+pub fn lobe_product_input<'a>(
+    pairs: impl IntoIterator<Item = (&'a CosineLobe, &'a CosineLobe)>,
+) -> Columns {
+    let rows: Vec<[f32; 10]> = pairs
+        .into_iter()
+        .map(|(x, y)| {
+            let (p, q) = (x.axis(), y.axis());
+            [
+                p.x,
+                p.y,
+                p.z,
+                x.scale(),
+                x.exponent(),
+                q.x,
+                q.y,
+                q.z,
+                y.scale(),
+                y.exponent(),
+            ]
+        })
+        .collect();
+    Columns::from_rows(&rows)
+}
+
 /// Runs [`wgsl::LOBE_PRODUCT`] on `input` (the 10 columns
 /// `[a1x, a1y, a1z, s1, e1, a2x, a2y, a2z, s2, e2]`) into `out` (5 columns
 /// `[ax, ay, az, scale, exponent]`, same length).
@@ -83,27 +109,8 @@ pub fn run_lobe_product_gpu(
         )));
     }
     let table = ProductGpuTable::builtin()?;
-    let rows: Vec<[f32; 10]> = a
-        .iter()
-        .zip(b)
-        .map(|(x, y)| {
-            let (p, q) = (x.axis(), y.axis());
-            [
-                p.x,
-                p.y,
-                p.z,
-                x.scale(),
-                x.exponent(),
-                q.x,
-                q.y,
-                q.z,
-                y.scale(),
-                y.exponent(),
-            ]
-        })
-        .collect();
-    let input = Columns::from_rows(&rows);
-    let n = rows.len();
+    let input = lobe_product_input(a.iter().zip(b));
+    let n = input.n;
     let mut out = Columns::zeros(5, n);
     run_lobe_product_columns(gpu, &table, &input, &mut out)?;
     let col = |c: usize, i: usize| out.data[c * n + i];
