@@ -15,43 +15,28 @@ use std::hint::black_box;
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use imageproc::distance_transform::euclidean_squared_distance_transform;
 use imageproc::image::{GrayImage, Luma};
-use steradian_core::cap::SphericalCap;
+use steradian_core::Vec2;
 use steradian_core::sat::Sat;
 use steradian_core::vdt::{Vdt, scratch_len, signed_distance_into};
-use steradian_core::visibility::{self, Outside};
-use steradian_core::{Vec2, Vec3};
 use steradian_harness::rng::Rng;
+use steradian_harness::vdt::spheres_mask;
 
 const N: usize = 512;
 const Q: usize = 1 << 16;
 
-fn mask() -> Vec<bool> {
-    let caps = [
-        SphericalCap::new(Vec3::new(0.3, 0.2, 0.9), 0.4).unwrap(),
-        SphericalCap::new(Vec3::new(-0.7, 0.1, 0.3), 0.5).unwrap(),
-        SphericalCap::new(Vec3::new(0.1, -0.8, 0.5), 0.3).unwrap(),
-    ];
-    let mut cov = vec![0.0f32; N * N];
-    visibility::coverage_into(&caps, N, Outside::Visible, &mut cov).unwrap();
-    cov.iter().map(|&c| c >= 0.5).collect()
-}
-
 fn edt(c: &mut Criterion) {
-    let m = mask();
-    let occluded = GrayImage::from_fn(N as u32, N as u32, |x, y| {
-        Luma([if m[y as usize * N + x as usize] {
-            0
-        } else {
-            255
-        }])
-    });
-    let visible = GrayImage::from_fn(N as u32, N as u32, |x, y| {
-        Luma([if m[y as usize * N + x as usize] {
-            255
-        } else {
-            0
-        }])
-    });
+    let m = spheres_mask(N);
+    // Foreground (255) where the map is `class`: imageproc's distances are to it.
+    let image = |class: bool| {
+        GrayImage::from_fn(N as u32, N as u32, |x, y| {
+            Luma([if m[y as usize * N + x as usize] == class {
+                255
+            } else {
+                0
+            }])
+        })
+    };
+    let (occluded, visible) = (image(false), image(true));
     let mut out = vec![0.0f32; N * N];
     let mut scratch = vec![0.0f64; scratch_len(N, N)];
     let mut g = c.benchmark_group("edt-512");
@@ -75,7 +60,7 @@ fn edt(c: &mut Criterion) {
 }
 
 fn queries(c: &mut Criterion) {
-    let m = mask();
+    let m = spheres_mask(N);
     let vdt = Vdt::build(N, N, &m).unwrap();
     let view = vdt.view();
     let texels: Vec<f32> = m.iter().map(|&b| b as u8 as f32).collect();

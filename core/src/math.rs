@@ -4,13 +4,13 @@
 
 // Some functions serve only modules behind the `alloc` feature; without it they are unused.
 macro_rules! shim {
-    ($( $name:ident ( $($arg:ident),* ) => $method:ident ; )*) => {
+    ($( $name:ident ( $t:ty $(, $arg:ident)* ) => $method:ident, $libm:ident ; )*) => {
         #[cfg(feature = "std")]
         mod imp {
             $(
                 #[inline(always)]
                 #[cfg_attr(not(feature = "alloc"), allow(dead_code))]
-                pub fn $name(x: f32 $(, $arg: f32)*) -> f32 {
+                pub fn $name(x: $t $(, $arg: $t)*) -> $t {
                     x.$method($($arg),*)
                 }
             )*
@@ -21,8 +21,8 @@ macro_rules! shim {
             $(
                 #[inline(always)]
                 #[cfg_attr(not(feature = "alloc"), allow(dead_code))]
-                pub fn $name(x: f32 $(, $arg: f32)*) -> f32 {
-                    libm::$name(x $(, $arg)*)
+                pub fn $name(x: $t $(, $arg: $t)*) -> $t {
+                    libm::$libm(x $(, $arg)*)
                 }
             )*
         }
@@ -32,7 +32,7 @@ macro_rules! shim {
             // The crate root emits a `compile_error!`; these keep the rest of the build quiet.
             $(
                 #[allow(dead_code)]
-                pub fn $name(x: f32 $(, $arg: f32)*) -> f32 {
+                pub fn $name(x: $t $(, $arg: $t)*) -> $t {
                     $( let _ = $arg; )*
                     x
                 }
@@ -42,60 +42,21 @@ macro_rules! shim {
 }
 
 shim! {
-    sqrtf() => sqrt;
-    expf() => exp;
-    expm1f() => exp_m1;
-    logf() => ln;
-    log1pf() => ln_1p;
-    powf(y) => powf;
-    sinf() => sin;
-    cosf() => cos; // used by `brdf_sat` (feature `alloc`) only
-    asinf() => asin;
-    atan2f(x2) => atan2;
-    ceilf() => ceil;
-    floorf() => floor;
+    sqrtf(f32) => sqrt, sqrtf;
+    expf(f32) => exp, expf;
+    expm1f(f32) => exp_m1, expm1f;
+    logf(f32) => ln, logf;
+    log1pf(f32) => ln_1p, log1pf;
+    powf(f32, y) => powf, powf;
+    sinf(f32) => sin, sinf;
+    cosf(f32) => cos, cosf; // used by `brdf_sat` (feature `alloc`) only
+    asinf(f32) => asin, asinf;
+    atan2f(f32, x2) => atan2, atan2f;
+    ceilf(f32) => ceil, ceilf;
+    floorf(f32) => floor, floorf;
+    // f64 for table builders and statistics, not hot paths.
+    sqrt64(f64) => sqrt, sqrt;
+    cbrt64(f64) => cbrt, cbrt;
 }
 
 pub(crate) use imp::*;
-
-/// `f64` square root and cube root (table builders and statistics, not hot paths), from the
-/// same backend as the `f32` functions above.
-#[cfg(feature = "std")]
-mod imp64 {
-    #[inline(always)]
-    #[allow(dead_code)]
-    pub fn sqrt64(x: f64) -> f64 {
-        x.sqrt()
-    }
-    #[inline(always)]
-    #[allow(dead_code)]
-    pub fn cbrt64(x: f64) -> f64 {
-        x.cbrt()
-    }
-}
-#[cfg(all(not(feature = "std"), feature = "libm"))]
-mod imp64 {
-    #[inline(always)]
-    #[allow(dead_code)]
-    pub fn sqrt64(x: f64) -> f64 {
-        libm::sqrt(x)
-    }
-    #[inline(always)]
-    #[allow(dead_code)]
-    pub fn cbrt64(x: f64) -> f64 {
-        libm::cbrt(x)
-    }
-}
-#[cfg(not(any(feature = "std", feature = "libm")))]
-mod imp64 {
-    // Unreachable: the crate root emits a `compile_error!`.
-    #[allow(dead_code)]
-    pub fn sqrt64(x: f64) -> f64 {
-        x
-    }
-    #[allow(dead_code)]
-    pub fn cbrt64(x: f64) -> f64 {
-        x
-    }
-}
-pub(crate) use imp64::*;

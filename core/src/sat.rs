@@ -56,7 +56,7 @@
 //! `n·2⁻⁵⁹·T` is below `10⁻¹⁰` for any box up to 256×256, so box sums are within one `f32`
 //! ulp of their own magnitude anywhere in the table, and so at 2048² and beyond (the last
 //! term grows like `n·T`: for a whole-table box of `N` cells it is `N·2⁻³⁵` ulps, `2⁻¹¹` ulp at
-//! //! 2²⁴ cells = 4096²). What no summed-area table can do — and this one does not claim — is
+//! 2²⁴ cells = 4096²). What no summed-area table can do — and this one does not claim — is
 //! resolve a box whose integral is below `2⁻⁵⁹·T` (a region of tiny texels in a table
 //! dominated by huge ones): such boxes get an absolute, not relative, accuracy.
 //!
@@ -255,17 +255,9 @@ impl<'a> SatView<'a> {
         exponent: i32,
         sums: &'a [i64],
     ) -> Result<SatView<'a>, Error> {
-        check_side("width", width)?;
-        check_side("height", height)?;
-        let want = (width + 1) * (height + 1);
-        if sums.len() != want {
-            return Err(Error::OutOfRange {
-                what: "sums.len()",
-                value: sums.len() as f32,
-                min: want as f32,
-                max: want as f32,
-            });
-        }
+        check_side("width", width, MAX_SIDE)?;
+        check_side("height", height, MAX_SIDE)?;
+        check_len("sums.len()", sums.len(), entries(width, height)?)?;
         if !(MIN_EXPONENT..=MAX_EXPONENT).contains(&exponent) {
             return Err(Error::OutOfRange {
                 what: "exponent",
@@ -361,19 +353,8 @@ impl<'a> SatView<'a> {
     /// their results through memory) so that the integer path inlines into callers' loops.
     #[inline(never)]
     fn fractional_box(&self, u0: f32, v0: f32, u1: f32, v1: f32) -> f64 {
-        if u0.is_nan() || v0.is_nan() || u1.is_nan() || v1.is_nan() {
-            return f64::NAN;
-        }
-        let (i0, a0, i1, a1) = axis(u0, u1, self.width);
-        let (j0, b0, j1, b1) = axis(v0, v1, self.height);
-        let t = BoxTerms {
-            k: self.integer_terms((i0, i1), (j0, j1), (b0, b1)),
-            a0,
-            a1,
-            b0,
-            b1,
-        };
-        t.combine() * self.scale
+        self.terms(u0, v0, u1, v1)
+            .map_or(f64::NAN, |t| t.combine() * self.scale)
     }
 
     /// The integral over the box between the integer corners `(x0, y0)` and `(x1, y1)`
@@ -544,15 +525,11 @@ fn build_entries<T>(
 ) -> Result<i32, Error> {
     check_shape(width, height, texels.len())?;
     let w1 = width + 1;
-    let len = w1 * (height + 1);
-    if sums.len() != len {
-        return Err(Error::OutOfRange {
-            what: "sums.len() (must be (width + 1)·(height + 1))",
-            value: sums.len() as f32,
-            min: len as f32,
-            max: len as f32,
-        });
-    }
+    check_len(
+        "sums.len() (must be (width + 1)·(height + 1))",
+        sums.len(),
+        entries(width, height)?,
+    )?;
     // Eight partial sums (the order does not matter: the sum only sets the quantum, with
     // headroom) and a flag, so that the pass vectorises; the error, if any, is found after.
     let mut partial = [0.0f64; 8];
@@ -600,30 +577,54 @@ fn build_entries<T>(
 
 /// Width, height and texel count of a grid to build.
 fn check_shape(width: usize, height: usize, len: usize) -> Result<(), Error> {
-    check_side("width", width)?;
-    check_side("height", height)?;
-    let n = width * height;
-    if len != n {
+    check_side("width", width, MAX_SIDE)?;
+    check_side("height", height, MAX_SIDE)?;
+    let n = checked_product("texel count", width, height)?;
+    check_len("texels.len() (must be width·height)", len, n)
+}
+
+/// `(width + 1)·(height + 1)`, the number of table entries (sides already checked).
+fn entries(width: usize, height: usize) -> Result<usize, Error> {
+    checked_product("table entries", width + 1, height + 1)
+}
+
+// The shape checks of the grid constructors (here, `vdt` and `visibility`).
+
+/// `Err` unless `1 ≤ n ≤ max`: a grid side.
+pub(crate) fn check_side(what: &'static str, n: usize, max: usize) -> Result<(), Error> {
+    if n == 0 || n > max {
         return Err(Error::OutOfRange {
-            what: "texels.len() (must be width·height)",
-            value: len as f32,
-            min: n as f32,
-            max: n as f32,
+            what,
+            value: n as f32,
+            min: 1.0,
+            max: max as f32,
         });
     }
     Ok(())
 }
 
-fn check_side(what: &'static str, n: usize) -> Result<(), Error> {
-    if n == 0 || n > MAX_SIDE {
+/// `Err` unless a slice length `got` is exactly `want`.
+pub(crate) fn check_len(what: &'static str, got: usize, want: usize) -> Result<(), Error> {
+    if got != want {
         return Err(Error::OutOfRange {
             what,
-            value: n as f32,
-            min: 1.0,
-            max: MAX_SIDE as f32,
+            value: got as f32,
+            min: want as f32,
+            max: want as f32,
         });
     }
     Ok(())
+}
+
+/// `a·b`, or `Err` where it overflows `usize` (sides of up to `2²⁴` can only overflow a
+/// `usize` narrower than 64 bits).
+pub(crate) fn checked_product(what: &'static str, a: usize, b: usize) -> Result<usize, Error> {
+    a.checked_mul(b).ok_or(Error::OutOfRange {
+        what,
+        value: f32::INFINITY,
+        min: 1.0,
+        max: usize::MAX as f32,
+    })
 }
 
 #[cfg(feature = "alloc")]
@@ -633,7 +634,7 @@ pub use owned::Sat;
 mod owned {
     use alloc::vec::Vec;
 
-    use super::{SatView, build_entries, check_shape};
+    use super::{SatView, build_entries, check_shape, entries};
     use crate::{Error, Vec2};
 
     /// An owned summed-area table (exact fixed-point `i64` entries); see the module docs.
@@ -668,7 +669,7 @@ mod owned {
             get: impl Fn(&T) -> f64,
         ) -> Result<Sat, Error> {
             check_shape(width, height, texels.len())?;
-            let len = (width + 1) * (height + 1);
+            let len = entries(width, height)?;
             let mut sums = Vec::new();
             sums.try_reserve_exact(len).map_err(|_| Error::OutOfRange {
                 what: "table entries (allocation failed)",

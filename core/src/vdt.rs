@@ -70,6 +70,7 @@
 
 use crate::Error;
 use crate::math;
+use crate::sat::{check_len, check_side, checked_product};
 use core::f32::consts::SQRT_2;
 
 /// Largest width or height of a table: every texel coordinate is an exact `f32`, and every
@@ -100,30 +101,11 @@ pub const fn scratch_len(w: usize, h: usize) -> usize {
     (w + 1) * (h + 5)
 }
 
-fn check_shape(w: usize, h: usize) -> Result<(), Error> {
-    for (what, n) in [("VDT width", w), ("VDT height", h)] {
-        if n == 0 || n > MAX_SIDE {
-            return Err(Error::OutOfRange {
-                what,
-                value: n as f32,
-                min: 1.0,
-                max: MAX_SIDE as f32,
-            });
-        }
-    }
-    Ok(())
-}
-
-fn check_len(what: &'static str, got: usize, want: usize) -> Result<(), Error> {
-    if got != want {
-        return Err(Error::OutOfRange {
-            what,
-            value: got as f32,
-            min: want as f32,
-            max: want as f32,
-        });
-    }
-    Ok(())
+/// `w·h` after checking both sides (`1 ≤ side ≤ MAX_SIDE`, and the product in `usize`).
+fn texel_count(w: usize, h: usize) -> Result<usize, Error> {
+    check_side("VDT width", w, MAX_SIDE)?;
+    check_side("VDT height", h, MAX_SIDE)?;
+    checked_product("VDT texel count", w, h)
 }
 
 /// The exact signed distance transform of a `w × h` binary map (`visible[j·w + i]`), written
@@ -141,13 +123,7 @@ pub fn signed_distance_into(
     out: &mut [f32],
     scratch: &mut [f64],
 ) -> Result<(), Error> {
-    check_shape(w, h)?;
-    let n = w.checked_mul(h).ok_or(Error::OutOfRange {
-        what: "VDT texel count",
-        value: f32::INFINITY,
-        min: 1.0,
-        max: usize::MAX as f32,
-    })?;
+    let n = texel_count(w, h)?;
     check_len("visibility map length", visible.len(), n)?;
     check_len("VDT output length", out.len(), n)?;
     let need = scratch_len(w, h);
@@ -336,7 +312,7 @@ pub fn signed_distance_into(
                 0.0
             } else {
                 // √(d2)/2, d2 ≥ 1: the nearest boundary point is at least ½ away.
-                (sqrt64(d2) * 0.5) as f32
+                (math::sqrt64(d2) * 0.5) as f32
             };
             if !m[i] {
                 out_row[i] = -out_row[i];
@@ -356,25 +332,6 @@ pub fn signed_distance_into(
     Ok(())
 }
 
-/// `√x` in `f64` (correctly rounded: the standard library's or `libm`'s).
-#[cfg(feature = "std")]
-#[inline(always)]
-fn sqrt64(x: f64) -> f64 {
-    x.sqrt()
-}
-/// `√x` in `f64` (correctly rounded: the standard library's or `libm`'s).
-#[cfg(all(not(feature = "std"), feature = "libm"))]
-#[inline(always)]
-fn sqrt64(x: f64) -> f64 {
-    libm::sqrt(x)
-}
-/// Unreachable: the crate root emits a `compile_error!` without a math backend.
-#[cfg(not(any(feature = "std", feature = "libm")))]
-#[inline(always)]
-fn sqrt64(x: f64) -> f64 {
-    x
-}
-
 /// The exact fraction of the square `[−1, 1]²` on the side `x·nx + y·ny ≥ −t` of a straight
 /// line, for a normal `(nx, ny)` (any length, not both zero: it is normalised here; a zero
 /// normal falls back to `(1, 0)`) and `t` the signed distance of the line from the centre in
@@ -391,7 +348,7 @@ fn sqrt64(x: f64) -> f64 {
 ///
 /// the divisions by `max(q, `[`Q_MIN`]`)`. Within a few `f32` ulps of the exact fraction
 /// (harness test against `f64` polygon clipping). NaN `t` gives NaN; `±∞` gives 1 or 0.
-#[inline]
+#[inline(always)]
 pub fn square_halfplane_fraction(t: f32, nx: f32, ny: f32) -> f32 {
     let (ax, ay) = (nx.abs(), ny.abs());
     let m = ax.max(ay);
@@ -445,8 +402,9 @@ pub struct Sample {
     pub gy: f32,
 }
 
-/// Column index `i0` (as `f32`), the fraction, and the step to `i1` for one axis of
-/// `len` centres at coordinate `x` (texel units, centres at `k + ½`).
+/// The index `i0` (an exact integer in `f32`, clamped to `[0, len − 2]`) of the first of
+/// the two centres around `x` and the fraction towards the next one (clamped to `[0, 1]`;
+/// 0 when `len = 1`), for one axis of `len` centres (texel units, centres at `k + ½`).
 #[inline(always)]
 pub fn axis(x: f32, len: usize) -> (f32, f32) {
     let c = x - 0.5;
@@ -470,14 +428,7 @@ impl<'a> VdtView<'a> {
     /// A view of `d` (`w·h` values, row-major). Every value must be finite with
     /// `|D| ≤ `[`NO_BOUNDARY`] (so interpolation and gradients cannot overflow).
     pub fn new(w: usize, h: usize, d: &'a [f32]) -> Result<Self, Error> {
-        check_shape(w, h)?;
-        let n = w.checked_mul(h).ok_or(Error::OutOfRange {
-            what: "VDT texel count",
-            value: f32::INFINITY,
-            min: 1.0,
-            max: usize::MAX as f32,
-        })?;
-        check_len("VDT length", d.len(), n)?;
+        check_len("VDT length", d.len(), texel_count(w, h)?)?;
         for &x in d {
             if !x.is_finite() {
                 return Err(Error::NonFinite { what: "VDT sample" });
@@ -588,12 +539,8 @@ pub fn eq9_from(d: f32, r: f32) -> f32 {
 /// `r/√2` cut by the line at signed distance `D` with normal along the gradient.
 #[inline(always)]
 pub fn gradient_from(s: Sample, r: f32) -> f32 {
-    let (ax, ay) = (s.gx.abs(), s.gy.abs());
-    let m = ax.max(ay);
-    let q = if m > 0.0 { ax.min(ay) / m } else { 0.0 };
     // D in units of the half-side r/√2.
-    let t = s.d * SQRT_2 / clamp_r(r);
-    edge_fraction(t, q)
+    square_halfplane_fraction(s.d * SQRT_2 / clamp_r(r), s.gx, s.gy)
 }
 
 #[cfg(feature = "alloc")]
@@ -617,13 +564,8 @@ mod owned {
         /// The VDT of a `w × h` binary map (`visible[j·w + i]`), exact
         /// ([`signed_distance_into`]).
         pub fn build(w: usize, h: usize, visible: &[bool]) -> Result<Vdt, Error> {
-            check_shape(w, h)?;
-            let n = w.checked_mul(h).ok_or(Error::OutOfRange {
-                what: "VDT texel count",
-                value: f32::INFINITY,
-                min: 1.0,
-                max: usize::MAX as f32,
-            })?;
+            // Checked before allocating: `signed_distance_into` checks again.
+            let n = texel_count(w, h)?;
             check_len("visibility map length", visible.len(), n)?;
             let mut d = vec![0.0f32; n];
             let mut scratch = vec![0.0f64; scratch_len(w, h)];
@@ -632,12 +574,13 @@ mod owned {
         }
 
         /// The VDT of a coverage map (visible fraction per texel, finite): a texel is
-        /// visible when its coverage is at least ½.
+        /// visible when its coverage is at least ½ ([`crate::visibility::binary_into`]).
         pub fn from_coverage(w: usize, h: usize, coverage: &[f32]) -> Result<Vdt, Error> {
             if coverage.iter().any(|c| !c.is_finite()) {
                 return Err(Error::NonFinite { what: "coverage" });
             }
-            let mask: Vec<bool> = coverage.iter().map(|&c| c >= 0.5).collect();
+            let mut mask = vec![false; coverage.len()];
+            crate::visibility::binary_into(coverage, &mut mask);
             Self::build(w, h, &mask)
         }
 

@@ -47,6 +47,7 @@ use crate::cap::SphericalCap;
 use crate::frame::Frame;
 use crate::hemisphere;
 use crate::math;
+use crate::sat::{check_len, check_side, checked_product};
 use crate::vdt::square_halfplane_fraction;
 use crate::{Error, Vec2, Vec3};
 
@@ -150,10 +151,11 @@ pub fn square_coverage(
     if !(c.is_finite() && hs.is_finite()) {
         return f32::NAN;
     }
-    area(caps, c, hs.abs(), outside.value(), depth)
+    area(caps, c, hs.abs(), outside, depth)
 }
 
-fn area(caps: &[SphericalCap], c: Vec2, hs: f32, ov: f32, depth: u32) -> f32 {
+fn area(caps: &[SphericalCap], c: Vec2, hs: f32, outside: Outside, depth: u32) -> f32 {
+    let ov = outside.value();
     let h = hs * core::f32::consts::SQRT_2;
     let rc = math::sqrtf(c.dot(c));
     let disk = classify(1.0 - rc, h);
@@ -191,7 +193,7 @@ fn area(caps: &[SphericalCap], c: Vec2, hs: f32, ov: f32, depth: u32) -> f32 {
         let q = 0.5 * hs;
         let mut s = 0.0;
         for (dx, dy) in [(-q, -q), (q, -q), (-q, q), (q, q)] {
-            s += area(caps, c + Vec2::new(dx, dy), q, ov, depth - 1);
+            s += area(caps, c + Vec2::new(dx, dy), q, outside, depth - 1);
         }
         return 0.25 * s;
     }
@@ -226,12 +228,7 @@ fn area(caps: &[SphericalCap], c: Vec2, hs: f32, ov: f32, depth: u32) -> f32 {
     for a in 0..4 {
         for b in 0..4 {
             let p = c + Vec2::new(hs * (a as f32 * 0.5 - 0.75), hs * (b as f32 * 0.5 - 0.75));
-            let vis = if p.dot(p) > 1.0 {
-                ov == 1.0
-            } else {
-                caps.iter().all(|k| cap_fn(k, p) <= 0.0)
-            };
-            n += vis as u32;
+            n += is_visible(caps, p, outside) as u32;
         }
     }
     n as f32 / 16.0
@@ -247,27 +244,14 @@ pub fn coverage_into(
     outside: Outside,
     out: &mut [f32],
 ) -> Result<(), Error> {
-    if n == 0 || n > MAX_SIDE {
-        return Err(Error::OutOfRange {
-            what: "visibility map side",
-            value: n as f32,
-            min: 1.0,
-            max: MAX_SIDE as f32,
-        });
-    }
-    if n.checked_mul(n) != Some(out.len()) {
-        return Err(Error::OutOfRange {
-            what: "visibility map length",
-            value: out.len() as f32,
-            min: (n * n) as f32,
-            max: (n * n) as f32,
-        });
-    }
+    check_side("visibility map side", n, MAX_SIDE)?;
+    let texels = checked_product("visibility map texel count", n, n)?;
+    check_len("visibility map length", out.len(), texels)?;
     let hs = 1.0 / n as f32;
     for (k, o) in out.iter_mut().enumerate() {
         let (i, j) = (k % n, k / n);
         let c = Vec2::new((2 * i + 1) as f32 * hs - 1.0, (2 * j + 1) as f32 * hs - 1.0);
-        *o = area(caps, c, hs, outside.value(), LEAF_DEPTH);
+        *o = area(caps, c, hs, outside, LEAF_DEPTH);
     }
     Ok(())
 }

@@ -168,7 +168,7 @@ pub fn eval_line(kernel: &str, line: &str) -> Result<Value, String> {
             let d = hemisphere::unmap(Vec2::new(u, v));
             Ok(json!({ "dir": [num(d.x), num(d.y), num(d.z)] }))
         }
-        "vdt-box" => crate::vdt::eval_vdt_box(line),
+        "vdt-box" => crate::vdt::eval_vdt_box(obj),
         other => Err(format!("unknown kernel {other}")),
     }
 }

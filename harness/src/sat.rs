@@ -23,23 +23,24 @@ pub struct Grid {
     pub texels: Vec<f32>,
 }
 
-/// Overlap of `[lo, hi]` (ordered, clipped to `[0, n]`) with `[i, i+1]`, in f64.
-fn overlap(c0: f32, c1: f32, n: usize, i: usize) -> f64 {
+/// The interval between `c0` and `c1`, ordered and clipped to `[0, n]`, in f64.
+fn clipped(c0: f32, c1: f32, n: usize) -> (f64, f64) {
     let (c0, c1) = (c0 as f64, c1 as f64);
-    let (lo, hi) = (
+    (
         c0.min(c1).clamp(0.0, n as f64),
         c0.max(c1).clamp(0.0, n as f64),
-    );
+    )
+}
+
+/// Overlap of `[lo, hi]` (ordered, clipped to `[0, n]`) with `[i, i+1]`, in f64.
+fn overlap(c0: f32, c1: f32, n: usize, i: usize) -> f64 {
+    let (lo, hi) = clipped(c0, c1, n);
     (hi.min(i as f64 + 1.0) - lo.max(i as f64)).max(0.0)
 }
 
 /// The column (or row) range `[first, last]` of texels with a positive overlap, if any.
 fn span(c0: f32, c1: f32, n: usize) -> Option<(usize, usize)> {
-    let (c0, c1) = (c0 as f64, c1 as f64);
-    let (lo, hi) = (
-        c0.min(c1).clamp(0.0, n as f64),
-        c0.max(c1).clamp(0.0, n as f64),
-    );
+    let (lo, hi) = clipped(c0, c1, n);
     if hi <= lo {
         return None;
     }
@@ -249,7 +250,7 @@ pub mod options {
     use super::Grid;
 
     /// Bilinear interpolation of a `(w+1)×(h+1)` table at `(u, v)` (clipped), in f64.
-    fn bilinear(s: impl Fn(usize, usize) -> f64, w: usize, h: usize, u: f64, v: f64) -> f64 {
+    fn bilinear(s: &impl Fn(usize, usize) -> f64, w: usize, h: usize, u: f64, v: f64) -> f64 {
         let u = u.clamp(0.0, w as f64);
         let v = v.clamp(0.0, h as f64);
         let i = (u.floor() as usize).min(w - 1);
@@ -266,18 +267,54 @@ pub mod options {
         if c1 < c0 { (c1, c0) } else { (c0, c1) }
     }
 
-    /// The f64 SAT of the texels (f64 accumulation), entries at `l·(w+1) + k`.
-    pub fn sat_f64(g: &Grid) -> Vec<f64> {
+    /// The box query of the f64-cornered options: the corners ordered, four bilinear
+    /// corners of the table `s` in f64, combined as `(S11 − S01) − (S10 − S00)`, rounded
+    /// to f32.
+    fn box_f64(
+        s: impl Fn(usize, usize) -> f64,
+        w: usize,
+        h: usize,
+        [u0, v0, u1, v1]: [f32; 4],
+    ) -> f64 {
+        let (u0, u1) = order(u0, u1);
+        let (v0, v1) = order(v0, v1);
+        let c = |u: f32, v: f32| bilinear(&s, w, h, u as f64, v as f64);
+        ((c(u1, v1) - c(u0, v1)) - (c(u1, v0) - c(u0, v0))) as f32 as f64
+    }
+
+    /// Bilinear interpolation in `f32` of a `(w+1)×(h+1)` `f32` table at `(u, v)`
+    /// (clipped), as a texture unit would.
+    fn corner_f32(s: &[f32], w: usize, h: usize, u: f32, v: f32) -> f32 {
+        let u = u.clamp(0.0, w as f32);
+        let v = v.clamp(0.0, h as f32);
+        let i = (u.floor() as usize).min(w - 1);
+        let j = (v.floor() as usize).min(h - 1);
+        let (a, b) = (u - i as f32, v - j as f32);
+        let w1 = w + 1;
+        let s00 = s[j * w1 + i];
+        let s10 = s[j * w1 + i + 1];
+        let s01 = s[(j + 1) * w1 + i];
+        let s11 = s[(j + 1) * w1 + i + 1];
+        (1.0 - b) * ((1.0 - a) * s00 + a * s10) + b * ((1.0 - a) * s01 + a * s11)
+    }
+
+    /// The f64 SAT of `f(t)` over the texels (f64 accumulation), entries at `l·(w+1) + k`.
+    fn prefix_f64(g: &Grid, f: impl Fn(f32) -> f64) -> Vec<f64> {
         let w1 = g.width + 1;
         let mut s = vec![0.0f64; w1 * (g.height + 1)];
         for j in 0..g.height {
             let mut acc = 0.0;
             for i in 0..g.width {
-                acc += g.at(i, j) as f64;
+                acc += f(g.at(i, j));
                 s[(j + 1) * w1 + i + 1] = s[j * w1 + i + 1] + acc;
             }
         }
         s
+    }
+
+    /// The f64 SAT of the texels (f64 accumulation), entries at `l·(w+1) + k`.
+    pub fn sat_f64(g: &Grid) -> Vec<f64> {
+        prefix_f64(g, f64::from)
     }
 
     /// A storage option.
@@ -320,19 +357,7 @@ pub mod options {
         /// Bilinear corner value in f32.
         #[inline]
         fn corner(&self, u: f32, v: f32) -> f32 {
-            let (w, h) = (self.w, self.h);
-            let u = u.clamp(0.0, w as f32);
-            let v = v.clamp(0.0, h as f32);
-            let i = (u.floor() as usize).min(w - 1);
-            let j = (v.floor() as usize).min(h - 1);
-            let (a, b) = (u - i as f32, v - j as f32);
-            let w1 = w + 1;
-            let s = &self.s;
-            let s00 = s[j * w1 + i];
-            let s10 = s[j * w1 + i + 1];
-            let s01 = s[(j + 1) * w1 + i];
-            let s11 = s[(j + 1) * w1 + i + 1];
-            (1.0 - b) * ((1.0 - a) * s00 + a * s10) + b * ((1.0 - a) * s01 + a * s11)
+            corner_f32(&self.s, self.w, self.h, u, v)
         }
 
         /// Integer-corner box sum, four lookups in f32 (the peers' query).
@@ -377,15 +402,7 @@ pub mod options {
         /// Builds it.
         pub fn build(g: &Grid) -> Self {
             let mean = g.texels.iter().map(|t| *t as f64).sum::<f64>() / g.texels.len() as f64;
-            let w1 = g.width + 1;
-            let mut s = vec![0.0f64; w1 * (g.height + 1)];
-            for j in 0..g.height {
-                let mut acc = 0.0;
-                for i in 0..g.width {
-                    acc += g.at(i, j) as f64 - mean;
-                    s[(j + 1) * w1 + i + 1] = s[j * w1 + i + 1] + acc;
-                }
-            }
+            let s = prefix_f64(g, |t| t as f64 - mean);
             MeanOffsetF32 {
                 w: g.width,
                 h: g.height,
@@ -405,18 +422,8 @@ pub mod options {
         fn box_sum(&self, u0: f32, v0: f32, u1: f32, v1: f32) -> f64 {
             let (u0, u1) = order(u0, u1);
             let (v0, v1) = order(v0, v1);
-            let w1 = self.w + 1;
             let (w, h) = (self.w, self.h);
-            let c = |u: f32, v: f32| -> f32 {
-                let u = u.clamp(0.0, w as f32);
-                let v = v.clamp(0.0, h as f32);
-                let i = (u.floor() as usize).min(w - 1);
-                let j = (v.floor() as usize).min(h - 1);
-                let (a, b) = (u - i as f32, v - j as f32);
-                let s = &self.s;
-                (1.0 - b) * ((1.0 - a) * s[j * w1 + i] + a * s[j * w1 + i + 1])
-                    + b * ((1.0 - a) * s[(j + 1) * w1 + i] + a * s[(j + 1) * w1 + i + 1])
-            };
+            let c = |u: f32, v: f32| corner_f32(&self.s, w, h, u, v);
             let d = c(u1, v1) - c(u0, v1) - c(u1, v0) + c(u0, v0);
             let cl = |x: f32, n: usize| (x as f64).clamp(0.0, n as f64);
             let area = (cl(u1, w) - cl(u0, w)) * (cl(v1, h) - cl(v0, h));
@@ -474,15 +481,12 @@ pub mod options {
             self.local.len() * 4 + self.base.len() * 8
         }
         fn box_sum(&self, u0: f32, v0: f32, u1: f32, v1: f32) -> f64 {
-            let (u0, u1) = order(u0, u1);
-            let (v0, v1) = order(v0, v1);
             let w1 = self.w + 1;
             let s = |k: usize, l: usize| {
                 self.base[(l / self.tile) * self.tiles_x + k / self.tile]
                     + self.local[l * w1 + k] as f64
             };
-            let c = |u: f32, v: f32| bilinear(s, self.w, self.h, u as f64, v as f64);
-            ((c(u1, v1) - c(u0, v1)) - (c(u1, v0) - c(u0, v0))) as f32 as f64
+            box_f64(s, self.w, self.h, [u0, v0, u1, v1])
         }
     }
 
@@ -522,12 +526,9 @@ pub mod options {
             self.hi.len() * 8
         }
         fn box_sum(&self, u0: f32, v0: f32, u1: f32, v1: f32) -> f64 {
-            let (u0, u1) = order(u0, u1);
-            let (v0, v1) = order(v0, v1);
             let w1 = self.w + 1;
             let s = |k: usize, l: usize| self.hi[l * w1 + k] as f64 + self.lo[l * w1 + k] as f64;
-            let c = |u: f32, v: f32| bilinear(s, self.w, self.h, u as f64, v as f64);
-            ((c(u1, v1) - c(u0, v1)) - (c(u1, v0) - c(u0, v0))) as f32 as f64
+            box_f64(s, self.w, self.h, [u0, v0, u1, v1])
         }
     }
 
@@ -557,12 +558,8 @@ pub mod options {
             self.s.len() * 8
         }
         fn box_sum(&self, u0: f32, v0: f32, u1: f32, v1: f32) -> f64 {
-            let (u0, u1) = order(u0, u1);
-            let (v0, v1) = order(v0, v1);
             let w1 = self.w + 1;
-            let s = |k: usize, l: usize| self.s[l * w1 + k];
-            let c = |u: f32, v: f32| bilinear(s, self.w, self.h, u as f64, v as f64);
-            ((c(u1, v1) - c(u0, v1)) - (c(u1, v0) - c(u0, v0))) as f32 as f64
+            box_f64(|k, l| self.s[l * w1 + k], self.w, self.h, [u0, v0, u1, v1])
         }
     }
 

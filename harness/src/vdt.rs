@@ -8,7 +8,7 @@
 //! along `v`; a query is a square with centre `(u, v)` and half-diagonal `r` (half-side
 //! `r/√2`).
 
-use serde_json::{Value, json};
+use serde_json::{Map, Value, json};
 use steradian_core::cap::SphericalCap;
 use steradian_core::sat::Sat;
 use steradian_core::vdt::Vdt;
@@ -17,6 +17,16 @@ use steradian_core::{Vec2, Vec3};
 
 use crate::eval::num;
 use crate::rng::Rng;
+
+/// `±√d2` rounded to `f32` (`+` visible), or `±NO_BOUNDARY` for `d2 = ∞` (no boundary).
+fn signed(d2: f64, visible: bool) -> f32 {
+    let d = if d2.is_finite() {
+        d2.sqrt() as f32
+    } else {
+        steradian_core::vdt::NO_BOUNDARY
+    };
+    if visible { d } else { -d }
+}
 
 /// Brute-force signed distance from every texel centre to the boundary (the union of the
 /// texel edges between the two classes): the minimum over every such edge of the `f64`
@@ -50,12 +60,7 @@ pub fn brute_force_edges(w: usize, h: usize, mask: &[bool]) -> Vec<f32> {
                 let dy = py - py.clamp(y0, y1);
                 best = best.min(dx * dx + dy * dy);
             }
-            let d = if best.is_finite() {
-                best.sqrt() as f32
-            } else {
-                steradian_core::vdt::NO_BOUNDARY
-            };
-            out[j * w + i] = if m(i, j) { d } else { -d };
+            out[j * w + i] = signed(best, m(i, j));
         }
     }
     out
@@ -79,12 +84,7 @@ pub fn brute_force_squares(w: usize, h: usize, mask: &[bool]) -> Vec<f32> {
                     }
                 }
             }
-            let d = if best.is_finite() {
-                best.sqrt() as f32
-            } else {
-                steradian_core::vdt::NO_BOUNDARY
-            };
-            out[j * w + i] = if me { d } else { -d };
+            out[j * w + i] = signed(best, me);
         }
     }
     out
@@ -120,6 +120,21 @@ pub fn polygon_area(p: &[[f64; 2]]) -> f64 {
 
 fn rect(x0: f64, y0: f64, x1: f64, y1: f64) -> [[f64; 2]; 4] {
     [[x0, y0], [x1, y0], [x1, y1], [x0, y1]]
+}
+
+/// The binary visibility map (coverage ≥ ½) of three sphere occluders on an `n × n` grid:
+/// the map of the report's and the bench's timings.
+pub fn spheres_mask(n: usize) -> Vec<bool> {
+    let caps = [
+        SphericalCap::new(Vec3::new(0.3, 0.2, 0.9), 0.4).expect("cap"),
+        SphericalCap::new(Vec3::new(-0.7, 0.1, 0.3), 0.5).expect("cap"),
+        SphericalCap::new(Vec3::new(0.1, -0.8, 0.5), 0.3).expect("cap"),
+    ];
+    let mut cov = vec![0.0f32; n * n];
+    visibility::coverage_into(&caps, n, Outside::Visible, &mut cov).expect("grid");
+    let mut mask = vec![false; n * n];
+    visibility::binary_into(&cov, &mut mask);
+    mask
 }
 
 /// A visibility pattern in the plane of the map (texel units), with its exact coverage.
@@ -232,7 +247,8 @@ impl Shape {
                 })
                 .collect(),
         };
-        let mask = cov.iter().map(|&c| c >= 0.5).collect();
+        let mut mask = vec![false; cov.len()];
+        visibility::binary_into(&cov, &mut mask);
         (cov, mask)
     }
 }
@@ -372,55 +388,62 @@ fn random_shape(family: Family, rng: &mut Rng) -> Shape {
     }
 }
 
+/// Up to `per_map` boundary-crossing query squares on the [`STUDY_SIZE`]² map of `shape`
+/// (half-diagonal log-uniform in `[1, 8]` texels, inside the grid, the binary map's
+/// coverage strictly between 0 and 1), each with its estimates and references.
+fn map_queries(shape: &Shape, rng: &mut Rng, per_map: usize, out: &mut Vec<QueryResult>) {
+    let n = STUDY_SIZE;
+    let (_, mask) = shape.rasterize(n, n);
+    let vdt = Vdt::build(n, n, &mask).expect("valid map");
+    let view = vdt.view();
+    let texels: Vec<f32> = mask.iter().map(|&b| b as u8 as f32).collect();
+    let sat = Sat::build(n, n, &texels).expect("valid map");
+    let sums = MaskSums::new(n, n, &mask);
+    let mut got = 0;
+    let mut tries = 0;
+    while got < per_map && tries < per_map * 200 {
+        tries += 1;
+        let r = rng.log_range(1.0, 8.0);
+        let hs = r / std::f64::consts::SQRT_2;
+        let (u, v) = (rng.range(hs, n as f64 - hs), rng.range(hs, n as f64 - hs));
+        let (uf, vf, rf) = (u as f32, v as f32, r as f32);
+        // The box of the f32 query, as the kernels see it.
+        let hsf = steradian_core::sat::square_half_side(rf) as f64;
+        let (x0, y0, x1, y1) = (
+            uf as f64 - hsf,
+            vf as f64 - hsf,
+            uf as f64 + hsf,
+            vf as f64 + hsf,
+        );
+        let a = (x1 - x0) * (y1 - y0);
+        let mask_frac = sums.area(x0, y0, x1, y1) / a;
+        if !(mask_frac > 0.0 && mask_frac < 1.0) {
+            continue;
+        }
+        let truth = shape.visible_area(x0, y0, x1, y1) / a;
+        let (eq9, gradient) = view.query(uf, vf, rf);
+        let sat_frac = (sat.square(Vec2::new(uf, vf), rf) as f64 / a) as f32;
+        out.push(QueryResult {
+            q: [uf, vf, rf],
+            eq9,
+            gradient,
+            sat: sat_frac,
+            mask: mask_frac,
+            truth,
+        });
+        got += 1;
+    }
+}
+
 /// Runs one family: `maps` random shapes, `per_map` boundary-crossing query squares each
 /// (half-diagonal log-uniform in `[1, 8]` texels, inside the grid, the binary map's
 /// coverage strictly between 0 and 1). Returns every query's estimates and references.
 pub fn study(family: Family, seed: u64, maps: usize, per_map: usize) -> Vec<QueryResult> {
     let mut rng = Rng::new(seed ^ (family as u64 + 1).wrapping_mul(0x9e37_79b9));
-    let n = STUDY_SIZE;
     let mut out = Vec::with_capacity(maps * per_map);
     for _ in 0..maps {
         let shape = random_shape(family, &mut rng);
-        let (_, mask) = shape.rasterize(n, n);
-        let vdt = Vdt::build(n, n, &mask).expect("valid map");
-        let view = vdt.view();
-        let texels: Vec<f32> = mask.iter().map(|&b| b as u8 as f32).collect();
-        let sat = Sat::build(n, n, &texels).expect("valid map");
-        let sums = MaskSums::new(n, n, &mask);
-        let mut got = 0;
-        let mut tries = 0;
-        while got < per_map && tries < per_map * 200 {
-            tries += 1;
-            let r = rng.log_range(1.0, 8.0);
-            let hs = r / std::f64::consts::SQRT_2;
-            let (u, v) = (rng.range(hs, n as f64 - hs), rng.range(hs, n as f64 - hs));
-            let (uf, vf, rf) = (u as f32, v as f32, r as f32);
-            // The box of the f32 query, as the kernels see it.
-            let hsf = steradian_core::sat::square_half_side(rf) as f64;
-            let (x0, y0, x1, y1) = (
-                uf as f64 - hsf,
-                vf as f64 - hsf,
-                uf as f64 + hsf,
-                vf as f64 + hsf,
-            );
-            let a = (x1 - x0) * (y1 - y0);
-            let mask_frac = sums.area(x0, y0, x1, y1) / a;
-            if !(mask_frac > 0.0 && mask_frac < 1.0) {
-                continue;
-            }
-            let truth = shape.visible_area(x0, y0, x1, y1) / a;
-            let (eq9, gradient) = view.query(uf, vf, rf);
-            let sat_frac = (sat.square(Vec2::new(uf, vf), rf) as f64 / a) as f32;
-            out.push(QueryResult {
-                q: [uf, vf, rf],
-                eq9,
-                gradient,
-                sat: sat_frac,
-                mask: mask_frac,
-                truth,
-            });
-            got += 1;
-        }
+        map_queries(&shape, &mut rng, per_map, &mut out);
     }
     out
 }
@@ -496,8 +519,8 @@ pub fn edge_error_by_angle(
     bins: usize,
 ) -> Vec<(f64, [f64; 3])> {
     let mut rng = Rng::new(seed);
-    let n = STUDY_SIZE;
     let mut acc = vec![([0.0f64; 3], 0usize); bins];
+    let mut rs = Vec::with_capacity(per_map);
     for _ in 0..maps {
         let shape = random_shape(Family::Edges, &mut rng);
         let Shape::Edge { n: nrm, .. } = shape else {
@@ -505,37 +528,15 @@ pub fn edge_error_by_angle(
         };
         let ang = nrm[1].atan2(nrm[0]).to_degrees().rem_euclid(90.0);
         let bin = ((ang / 90.0 * bins as f64) as usize).min(bins - 1);
-        let (_, mask) = shape.rasterize(n, n);
-        let vdt = Vdt::build(n, n, &mask).expect("valid map");
-        let texels: Vec<f32> = mask.iter().map(|&b| b as u8 as f32).collect();
-        let sat = Sat::build(n, n, &texels).expect("valid map");
-        let sums = MaskSums::new(n, n, &mask);
-        let mut got = 0;
-        let mut tries = 0;
-        while got < per_map && tries < per_map * 200 {
-            tries += 1;
-            let r = rng.log_range(1.0, 8.0) as f32;
-            let hs = steradian_core::sat::square_half_side(r) as f64;
-            let (u, v) = (
-                rng.range(hs, n as f64 - hs) as f32,
-                rng.range(hs, n as f64 - hs) as f32,
-            );
-            let (x0, y0, x1, y1) = (u as f64 - hs, v as f64 - hs, u as f64 + hs, v as f64 + hs);
-            let a = (x1 - x0) * (y1 - y0);
-            let mf = sums.area(x0, y0, x1, y1) / a;
-            if !(mf > 0.0 && mf < 1.0) {
-                continue;
+        rs.clear();
+        map_queries(&shape, &mut rng, per_map, &mut rs);
+        let e = &mut acc[bin];
+        for q in &rs {
+            for (s, x) in e.0.iter_mut().zip([q.eq9, q.gradient, q.sat]) {
+                *s += (x as f64 - q.truth).abs();
             }
-            let t = shape.visible_area(x0, y0, x1, y1) / a;
-            let (e9, g) = vdt.query(u, v, r);
-            let s = sat.square(Vec2::new(u, v), r) as f64 / a;
-            let e = &mut acc[bin];
-            e.0[0] += (e9 as f64 - t).abs();
-            e.0[1] += (g as f64 - t).abs();
-            e.0[2] += (s - t).abs();
-            e.1 += 1;
-            got += 1;
         }
+        e.1 += rs.len();
     }
     acc.iter()
         .enumerate()
@@ -576,7 +577,7 @@ pub fn cap_area_in_hemisphere(alpha: f64, gamma: f64) -> f64 {
 /// over the polar angle of the exact union of the arcs each cap cuts from each circle of
 /// latitude (`f64`, `steps` midpoint steps in `cos θ`).
 pub fn visible_solid_angle_polar(caps: &[SphericalCap], steps: usize) -> f64 {
-    use std::f64::consts::{PI, TAU};
+    use std::f64::consts::TAU;
     let mut total = 0.0;
     for s in 0..steps {
         // Midpoint in z = cos θ (dω = dz dφ).
@@ -640,18 +641,13 @@ pub fn visible_solid_angle_polar(caps: &[SphericalCap], steps: usize) -> f64 {
         };
         total += (TAU - blocked) / steps as f64;
     }
-    let _ = PI;
     total
 }
 
 /// `steradian eval vdt-box`: `{"mask": ["0110…", …], "queries": [[u, v, r], …]}` (rows of
 /// `'0'`/`'1'`, row `j` along `v`, `'1'` visible; centre and half-diagonal in texel units)
 /// → `{"values": [eq. 9 per query], "values_gradient": [straight-edge variant per query]}`.
-pub fn eval_vdt_box(line: &str) -> Result<Value, String> {
-    let v: Value = serde_json::from_str(line).map_err(|e| format!("not JSON: {e}"))?;
-    let obj = v
-        .as_object()
-        .ok_or_else(|| "each line must be a JSON object".to_string())?;
+pub fn eval_vdt_box(obj: &Map<String, Value>) -> Result<Value, String> {
     let rows = obj
         .get("mask")
         .ok_or("missing field \"mask\"")?

@@ -3,15 +3,12 @@
 //! the SIMD kernel lane by lane (bit-exact), the WGSL kernel on a real adapter (within
 //! `wgsl::SAT_BOX_REL_TOL`), naga validation, and `steradian eval sat-box`.
 
-use std::io::Write;
-
 use proptest::prelude::*;
 use proptest::test_runner::{Config, RngSeed};
 use serde_json::{Value, json};
 use steradian_core::Vec2;
 use steradian_core::sat::{Sat, SatView};
 use steradian_core::wgsl;
-use steradian_harness::backend::gpu::{Gpu, gpu_required, try_gpu};
 use steradian_harness::eval;
 use steradian_harness::kernels::Columns;
 use steradian_harness::report::sat::{random_boxes, uniform_grid};
@@ -19,9 +16,9 @@ use steradian_harness::rng::Rng;
 use steradian_harness::sat::options::PlainF32;
 use steradian_harness::sat::{Grid, error_bound, gpu_box_sums, gpu_table, ulp};
 
-fn say(line: &str) {
-    let _ = writeln!(std::io::stderr(), "{line}");
-}
+#[path = "common/gpu.rs"]
+mod gpu_common;
+use gpu_common::{gpu, say};
 
 fn config(cases: u32) -> Config {
     Config {
@@ -39,24 +36,41 @@ fn build(g: &Grid) -> Sat {
     Sat::build(g.width, g.height, &g.texels).expect("valid grid")
 }
 
-/// Checks one box against the brute force and the stated bound.
+/// Checks one box against the brute force and the stated bound; and `box_sum_f64`, the
+/// same query before its rounding to `f32`, against the bound without the rounding terms
+/// (`2⁻⁴⁶·A + n·2⁻⁵⁹·T`, its doc comment).
 fn check(g: &Grid, sat: &Sat, t: f64, b: [f32; 4]) -> Result<(), String> {
     let r = g.reference(b[0], b[1], b[2], b[3]);
     let got = sat.box_sum(b[0], b[1], b[2], b[3]) as f64;
     // The brute force itself sums ≤ n terms in f64: allow its own rounding too.
     let slack = r.abs_read * r.n_read as f64 * 2f64.powi(-52);
     let bound = error_bound(&r, t) + slack;
-    if (got - r.value).abs() <= bound {
-        Ok(())
-    } else {
+    let fail = |what: &str, got: f64, bound: f64| {
         Err(format!(
-            "{}×{} box {b:?}: got {got:e}, exact {:e}, error {:e} > bound {bound:e}",
+            "{}×{} box {b:?}: {what} {got:e}, exact {:e}, error {:e} > bound {bound:e}",
             g.width,
             g.height,
             r.value,
             (got - r.value).abs()
         ))
+    };
+    if (got - r.value).abs() > bound {
+        return fail("got", got, bound);
     }
+    let got64 = sat.view().box_sum_f64(b[0], b[1], b[2], b[3]);
+    let bound64 = r.abs_read * 2f64.powi(-46) + r.n_read as f64 * 2f64.powi(-59) * t + slack;
+    if (got64 - r.value).abs() > bound64 {
+        return fail("box_sum_f64", got64, bound64);
+    }
+    Ok(())
+}
+
+/// A `w × h` grid of texels drawn from a random [`texel_gen`] distribution per texel.
+fn random_grid(w: usize, h: usize, rng: &mut Rng) -> Grid {
+    let texels = (0..w * h)
+        .map(|_| texel_gen(rng.next_u64() as u8, rng))
+        .collect();
+    Grid::new(w, h, texels).unwrap()
 }
 
 /// Texel distributions: uniform [0, 1), signed, log-uniform magnitudes over 60 decades
@@ -380,18 +394,26 @@ fn same(a: f32, b: f32) -> bool {
     a.to_bits() == b.to_bits() || (a.is_nan() && b.is_nan())
 }
 
+/// `steradian_simd::sat::box_sum_slices` over the boxes `qs`.
+fn simd_box_sums(v: &SatView<'_>, qs: &[[f32; 4]]) -> Vec<f32> {
+    let cols = Columns::from_rows(qs);
+    let mut out = vec![0.0; qs.len()];
+    steradian_simd::sat::box_sum_slices(
+        v,
+        cols.col(0),
+        cols.col(1),
+        cols.col(2),
+        cols.col(3),
+        &mut out,
+    );
+    out
+}
+
 #[test]
 fn simd_matches_scalar_bit_for_bit() {
     let mut rng = Rng::new(77);
     for (w, h) in [(1, 1), (1, 9), (9, 1), (17, 13), (64, 64), (300, 7)] {
-        let g = Grid::new(
-            w,
-            h,
-            (0..w * h)
-                .map(|_| texel_gen(rng.next_u64() as u8, &mut rng))
-                .collect(),
-        )
-        .unwrap();
+        let g = random_grid(w, h, &mut rng);
         let s = build(&g);
         let v = s.view();
         let specials = [f32::NAN, f32::INFINITY, -f32::INFINITY, -0.0, 0.0, 1e-45];
@@ -405,15 +427,7 @@ fn simd_matches_scalar_bit_for_bit() {
             };
             let qs: Vec<[f32; 4]> = (0..len).map(|_| [c(w), c(h), c(w), c(h)]).collect();
             let cols = Columns::from_rows(&qs);
-            let mut out = vec![0.0; len];
-            steradian_simd::sat::box_sum_slices(
-                &v,
-                cols.col(0),
-                cols.col(1),
-                cols.col(2),
-                cols.col(3),
-                &mut out,
-            );
+            let mut out = simd_box_sums(&v, &qs);
             for (k, q) in qs.iter().enumerate() {
                 let want = v.box_sum(q[0], q[1], q[2], q[3]);
                 assert!(
@@ -439,17 +453,10 @@ fn simd_matches_scalar_bit_for_bit() {
 fn integer_corner_fast_paths_match_the_general_query_bit_for_bit() {
     let mut rng = Rng::new(0x1c0);
     for (w, h) in [(1, 1), (1, 9), (9, 1), (17, 13), (64, 64), (300, 7)] {
-        let g = Grid::new(
-            w,
-            h,
-            (0..w * h)
-                .map(|_| texel_gen(rng.next_u64() as u8, &mut rng))
-                .collect(),
-        )
-        .unwrap();
+        let g = random_grid(w, h, &mut rng);
         let s = build(&g);
         let v = s.view();
-        let t: f64 = g.texels.iter().map(|&x| (x as f64).abs()).sum();
+        let t = g.abs_sum();
         let mut c = |n: usize| -> usize {
             match rng.next_u64() % 16 {
                 0 => n,
@@ -481,16 +488,7 @@ fn integer_corner_fast_paths_match_the_general_query_bit_for_bit() {
                     f
                 })
                 .collect();
-            let cols = Columns::from_rows(&fq);
-            let mut out = vec![0.0; fq.len()];
-            steradian_simd::sat::box_sum_slices(
-                &v,
-                cols.col(0),
-                cols.col(1),
-                cols.col(2),
-                cols.col(3),
-                &mut out,
-            );
+            let out = simd_box_sums(&v, &fq);
             for (k, f) in fq.iter().enumerate() {
                 let want = v.box_sum(f[0], f[1], f[2], f[3]);
                 assert!(
@@ -534,16 +532,8 @@ fn integer_boxes_of_integer_texels_are_correctly_rounded() {
             [x0, y0, x1, y1]
         })
         .collect();
-    let cols = Columns::from_rows(&qs.iter().map(|q| q.map(|x| x as f32)).collect::<Vec<_>>());
-    let mut out = vec![0.0; qs.len()];
-    steradian_simd::sat::box_sum_slices(
-        &v,
-        cols.col(0),
-        cols.col(1),
-        cols.col(2),
-        cols.col(3),
-        &mut out,
-    );
+    let fq: Vec<[f32; 4]> = qs.iter().map(|q| q.map(|x| x as f32)).collect();
+    let out = simd_box_sums(&v, &fq);
     for (k, q) in qs.iter().enumerate() {
         let want = exact(q[0], q[1], q[2], q[3]);
         let f = q.map(|x| x as f32);
@@ -577,22 +567,6 @@ fn sat_box_wgsl_validates() {
         .collect();
     for b in 0..4 {
         assert!(bindings.contains(&b), "binding {b}");
-    }
-}
-
-fn gpu() -> Option<Gpu> {
-    match try_gpu() {
-        Ok(g) => {
-            say(&format!("GPU tests ran on adapter: {}", g.adapter_info()));
-            Some(g)
-        }
-        Err(reason) => {
-            if gpu_required() {
-                panic!("STERADIAN_REQUIRE_GPU=1 but no GPU backend: {reason}");
-            }
-            say(&format!("GPU tests skipped: {reason}"));
-            None
-        }
     }
 }
 

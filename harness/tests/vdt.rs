@@ -6,16 +6,21 @@ use std::f64::consts::{FRAC_PI_2, PI, TAU};
 
 use proptest::prelude::*;
 use proptest::test_runner::{Config, RngSeed};
+use steradian_core::Vec3;
 use steradian_core::cap::SphericalCap;
 use steradian_core::frame::Frame;
 use steradian_core::vdt::{self, NO_BOUNDARY, Vdt, square_halfplane_fraction};
 use steradian_core::visibility::{self, Outside};
-use steradian_core::{Vec2, Vec3};
 use steradian_harness::rng::Rng;
 use steradian_harness::vdt::{
     Family, brute_force_edges, brute_force_squares, cap_area_in_hemisphere, caps_visible_area,
-    clip, errors, eval_vdt_box, polygon_area, study, visible_solid_angle_polar,
+    clip, errors, polygon_area, study, visible_solid_angle_polar,
 };
+
+/// One `eval vdt-box` line through the dispatcher (which parses the JSON for the handler).
+fn eval_vdt_box(line: &str) -> Result<serde_json::Value, String> {
+    steradian_harness::eval::eval_line("vdt-box", line)
+}
 
 fn config(cases: u32) -> Config {
     Config {
@@ -477,7 +482,6 @@ fn vdt_view_rejects_bad_tables() {
     assert!(vdt::VdtView::new(0, 2, &[]).is_err());
     assert!(Vdt::from_samples(1, 1, vec![f32::INFINITY]).is_err());
     assert!(Vdt::from_coverage(1, 1, &[f32::NAN]).is_err());
-    let _ = Vec2::ZERO;
 }
 
 /// The report section on its own (prints its summary and time; writes its SVG to

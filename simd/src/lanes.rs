@@ -359,7 +359,7 @@ pub(crate) fn drive<W: Lanes, K: ColumnKernel<I, O>, const I: usize, const O: us
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
 
     const VALUES: [f32; 14] = [
@@ -379,7 +379,8 @@ mod tests {
         1e30,
     ];
 
-    fn same(a: f32, b: f32) -> bool {
+    /// Bitwise equality, any NaN equal to any NaN (the lane-by-lane test of the kernels).
+    pub(crate) fn same(a: f32, b: f32) -> bool {
         a.to_bits() == b.to_bits() || (a.is_nan() && b.is_nan())
     }
 

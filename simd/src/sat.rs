@@ -11,6 +11,8 @@
 use steradian_core::sat::{SatView, square_half_side};
 use wide::{f32x8, f64x8, i64x8};
 
+use crate::lanes::{ColumnKernel, Lanes, drive};
+
 /// One axis of 8 boxes, lane-wise `steradian_core::sat::axis`: `(I0, a0, I1, a1)`, the
 /// indices as exact integers in `f32` lanes. Lanes must not be NaN.
 #[inline(always)]
@@ -108,6 +110,51 @@ pub fn square(sat: &SatView<'_>, cx: f32x8, cy: f32x8, r: f32x8) -> f32x8 {
     box_sum(sat, cx - h, cy - h, cx + h, cy + h)
 }
 
+/// Lanes `8c .. 8c + 8` of `x` (`W::N` is a multiple of 8).
+#[inline(always)]
+fn eighth<W: Lanes>(x: W, c: usize) -> f32x8 {
+    f32x8::new(core::array::from_fn(|k| x.lanes()[8 * c + k]))
+}
+
+/// The 8-lane kernel `f` over every group of 8 lanes of a `W`.
+#[inline(always)]
+fn by_eights<W: Lanes>(f: impl Fn(usize) -> f32x8) -> W {
+    let mut out = [0.0f32; 16];
+    for c in 0..W::N / 8 {
+        out[8 * c..8 * c + 8].copy_from_slice(f(c).as_array());
+    }
+    W::from_fn(|k| out[k])
+}
+
+struct BoxK<'a, 'b>(&'a SatView<'b>);
+impl ColumnKernel<4, 1> for BoxK<'_, '_> {
+    // Padding lanes: the empty box at the origin.
+    const PADS: [f32; 4] = [0.0; 4];
+    #[inline(always)]
+    fn apply<W: Lanes>(&self, [u0, v0, u1, v1]: [W; 4]) -> ([W; 1], W) {
+        let r = by_eights(|c| {
+            box_sum(
+                self.0,
+                eighth(u0, c),
+                eighth(v0, c),
+                eighth(u1, c),
+                eighth(v1, c),
+            )
+        });
+        ([r], W::splat(0.0))
+    }
+}
+
+struct SquareK<'a, 'b>(&'a SatView<'b>);
+impl ColumnKernel<3, 1> for SquareK<'_, '_> {
+    const PADS: [f32; 3] = [0.0; 3];
+    #[inline(always)]
+    fn apply<W: Lanes>(&self, [cx, cy, r]: [W; 3]) -> ([W; 1], W) {
+        let out = by_eights(|c| square(self.0, eighth(cx, c), eighth(cy, c), eighth(r, c)));
+        ([out], W::splat(0.0))
+    }
+}
+
 /// [`box_sum`] over columns: `out[i] = sat.box_sum(u0[i], v0[i], u1[i], v1[i])`. Any length
 /// (the tail is padded with empty boxes).
 ///
@@ -121,25 +168,7 @@ pub fn box_sum_slices(
     v1: &[f32],
     out: &mut [f32],
 ) {
-    let n = out.len();
-    assert!(
-        [u0.len(), v0.len(), u1.len(), v1.len()]
-            .iter()
-            .all(|&l| l == n),
-        "sat::box_sum_slices: column lengths differ"
-    );
-    let load =
-        |s: &[f32], i: usize| f32x8::new(core::array::from_fn(|k| *s.get(i + k).unwrap_or(&0.0)));
-    let mut i = 0;
-    while i + 8 <= n {
-        let r = box_sum(sat, load(u0, i), load(v0, i), load(u1, i), load(v1, i));
-        out[i..i + 8].copy_from_slice(r.as_array());
-        i += 8;
-    }
-    if i < n {
-        let r = box_sum(sat, load(u0, i), load(v0, i), load(u1, i), load(v1, i));
-        out[i..].copy_from_slice(&r.as_array()[..n - i]);
-    }
+    drive::<f32x8, _, 4, 1>("sat::box_sum_slices", &BoxK(sat), [u0, v0, u1, v1], [out]);
 }
 
 /// [`square`] over columns: `out[i] = sat.square((cx[i], cy[i]), r[i])`. Any length.
@@ -147,29 +176,13 @@ pub fn box_sum_slices(
 /// # Panics
 /// If the columns do not all have the same length.
 pub fn square_slices(sat: &SatView<'_>, cx: &[f32], cy: &[f32], r: &[f32], out: &mut [f32]) {
-    let n = out.len();
-    assert!(
-        [cx.len(), cy.len(), r.len()].iter().all(|&l| l == n),
-        "sat::square_slices: column lengths differ"
-    );
-    let load =
-        |s: &[f32], i: usize| f32x8::new(core::array::from_fn(|k| *s.get(i + k).unwrap_or(&0.0)));
-    let mut i = 0;
-    while i < n {
-        let r = square(sat, load(cx, i), load(cy, i), load(r, i));
-        let m = (n - i).min(8);
-        out[i..i + m].copy_from_slice(&r.as_array()[..m]);
-        i += 8;
-    }
+    drive::<f32x8, _, 3, 1>("sat::square_slices", &SquareK(sat), [cx, cy, r], [out]);
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    fn same(a: f32, b: f32) -> bool {
-        a.to_bits() == b.to_bits() || (a.is_nan() && b.is_nan())
-    }
+    use crate::lanes::tests::same;
 
     #[test]
     fn lanes_match_scalar_on_special_corners() {

@@ -130,6 +130,7 @@ pub fn query_slices(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::lanes::tests::same;
     use steradian_core::vdt::{scratch_len, signed_distance_into};
 
     /// The exact table of a mask (the crate has no `alloc` feature of core).
@@ -138,10 +139,6 @@ mod tests {
         let mut s = vec![0.0; scratch_len(w, h)];
         signed_distance_into(w, h, mask, &mut d, &mut s).unwrap();
         d
-    }
-
-    fn same(a: f32, b: f32) -> bool {
-        a.to_bits() == b.to_bits() || (a.is_nan() && b.is_nan())
     }
 
     #[test]

@@ -31,8 +31,8 @@ const ERROR_BOXES: usize = 1500;
 const QUERIES: usize = 1 << 18;
 /// Queries of the warm (in-cache) runs, repeated `QUERIES / WARM` times.
 const WARM: usize = 4096;
-/// Timed repeats (median reported).
-const REPEATS: usize = 5;
+/// Timed repeats (median reported; also the `vdt` section's).
+pub(super) const REPEATS: usize = 5;
 
 /// A grid of texels uniform in `[0, 1)` (the measurement).
 pub fn uniform_grid(n: usize, seed: u64) -> Grid {
@@ -71,8 +71,8 @@ fn median(mut t: Vec<Duration>) -> Duration {
     t[t.len() / 2]
 }
 
-/// Median time of `f` over [`REPEATS`] runs after one warm-up.
-fn time(mut f: impl FnMut()) -> Duration {
+/// Median time of `f` over [`REPEATS`] runs after one warm-up (also the `vdt` section's).
+pub(super) fn time(mut f: impl FnMut()) -> Duration {
     f();
     median(
         (0..REPEATS)

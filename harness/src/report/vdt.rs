@@ -8,51 +8,24 @@
 use std::error::Error;
 use std::fmt::Write as _;
 use std::hint::black_box;
-use std::time::{Duration, Instant};
+use std::time::Duration;
 
 use indicatif::{ProgressBar, ProgressStyle};
 use serde_json::json;
-use steradian_core::cap::SphericalCap;
 use steradian_core::sat::Sat;
 use steradian_core::vdt::{Vdt, scratch_len, signed_distance_into};
-use steradian_core::visibility::{self, Outside};
-use steradian_core::{Vec2, Vec3, wgsl};
+use steradian_core::{Vec2, wgsl};
 
 use super::Options;
+use super::sat::{REPEATS, time};
 use super::sections::Section;
 use crate::backend::gpu::{Custom, try_gpu};
 use crate::kernels::Columns;
 use crate::rng::Rng;
-use crate::vdt::{Dist, Family, edge_error_by_angle, errors, study};
+use crate::vdt::{Dist, Family, edge_error_by_angle, errors, spheres_mask, study};
 
 const SEED: u64 = 0x0bd7_5eed;
 const QUERIES: usize = 1 << 18;
-const REPEATS: usize = 5;
-
-fn time(mut f: impl FnMut()) -> Duration {
-    f();
-    let mut t: Vec<Duration> = (0..REPEATS)
-        .map(|_| {
-            let s = Instant::now();
-            f();
-            s.elapsed()
-        })
-        .collect();
-    t.sort();
-    t[t.len() / 2]
-}
-
-/// A binary visibility map of three sphere occluders on an `n × n` grid.
-fn spheres_mask(n: usize) -> Vec<bool> {
-    let caps = [
-        SphericalCap::new(Vec3::new(0.3, 0.2, 0.9), 0.4).expect("cap"),
-        SphericalCap::new(Vec3::new(-0.7, 0.1, 0.3), 0.5).expect("cap"),
-        SphericalCap::new(Vec3::new(0.1, -0.8, 0.5), 0.3).expect("cap"),
-    ];
-    let mut cov = vec![0.0f32; n * n];
-    visibility::coverage_into(&caps, n, Outside::Visible, &mut cov).expect("grid");
-    cov.iter().map(|&c| c >= 0.5).collect()
-}
 
 struct Speed {
     n: usize,
