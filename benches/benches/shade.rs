@@ -11,21 +11,12 @@ use steradian_core::brdf::{Brdf, Lambert, Phong};
 use steradian_core::shade::{self, ShadeLight, VdtQuery, VdtVisibility};
 use steradian_harness::env::{self, decompose};
 use steradian_harness::shade::{self as sh, Scene};
-use steradian_simd::shade::{IsoBrdfTables, ShadeInput, shade_batch};
+use steradian_simd::shade::{IsoBrdfTables, shade_batch};
 
 fn bench(c: &mut Criterion) {
     let cube = env::default_sky(32).unwrap();
     let ks = [10usize, 30, 100];
-    let decs = decompose::decompose(
-        &cube,
-        &decompose::Options {
-            ks: ks.to_vec(),
-            cross_face: true,
-            progress: false,
-            objective: decompose::Objective::Bound,
-        },
-    )
-    .unwrap();
+    let decs = decompose::decompose(&cube, &decompose::Options::quiet(&ks)).unwrap();
     let scene = Scene::standard(12);
     let vdts = sh::par_map(&scene.points, |p| sh::point_vdt(&scene, p, 128));
     let materials: [(&str, Box<dyn Brdf>); 2] = [
@@ -37,21 +28,12 @@ fn bench(c: &mut Criterion) {
     for (mname, brdf) in &materials {
         let refs: Vec<_> = decs.iter().collect();
         let sat = sh::fit_sat(brdf.as_ref(), &refs, 0.01);
-        let (views, s_max) = sh::iso_views(&sat).unwrap();
+        let views = sh::iso_views(&sat).unwrap();
         let tables = IsoBrdfTables {
             tables: &views,
-            s_max,
+            s_max: sat.s_max(),
         };
-        let inputs: Vec<ShadeInput<'_>> = scene
-            .points
-            .iter()
-            .zip(&vdts)
-            .map(|(p, v)| ShadeInput {
-                frame: p.frame,
-                wo: p.wo,
-                vdt: v.view(),
-            })
-            .collect();
+        let inputs = sh::simd_inputs(&scene, &vdts);
         for d in &decs {
             let lights: Vec<ShadeLight> = d.rsls().unwrap().iter().map(ShadeLight::from).collect();
             g.throughput(Throughput::Elements(

@@ -250,22 +250,7 @@ fn gl3<B: Brdf + ?Sized>(brdf: &B, wo: Vec3, x0: f64, y0: f64, x1: f64, y1: f64)
 fn rect_dist(q: (f64, f64), x0: f64, y0: f64, x1: f64, y1: f64) -> f64 {
     let dx = (x0 - q.0).max(q.0 - x1).max(0.0);
     let dy = (y0 - q.1).max(q.1 - y1).max(0.0);
-    sqrt64(dx * dx + dy * dy)
-}
-
-/// `√s` in `f64` without std: two Newton steps from the `f32` root (full `f64` precision
-/// for `s` in the `f32` range; only quadrature geometry and statistics use it).
-fn sqrt64(s: f64) -> f64 {
-    // NaN and non-positive → 0
-    if s.is_nan() || s <= 0.0 {
-        return 0.0;
-    }
-    let mut r = f64::from(math::sqrtf(s as f32));
-    if !(r > 0.0 && r.is_finite()) {
-        return 0.0;
-    }
-    r = 0.5 * (r + s / r);
-    0.5 * (r + s / r)
+    math::sqrt64(dx * dx + dy * dy)
 }
 
 /// Where the quadrature must resolve the BRDF: the specular peak (the mirror direction of
@@ -305,7 +290,7 @@ fn texel_integral<B: Brdf + ?Sized>(
     }
     let h = x1 - x0;
     let (fx, fy) = (x0.abs().max(x1.abs()), y0.abs().max(y1.abs()));
-    let far = sqrt64(fx * fx + fy * fy);
+    let far = math::sqrt64(fx * fx + fy * fy);
     let mut k: usize = if far > 1.0 { 2 } else { 1 };
     if rect_dist(f.peak, x0, y0, x1, y1) < 8.0 * f.size {
         // ⌈h/size⌉ sub-cells, at most 64 (no f64 `ceil` without std)
@@ -392,6 +377,12 @@ fn reference_rect<B: Brdf + ?Sized>(brdf: &B, wo: Vec3, rect: [f64; 4], tol: f64
     s
 }
 
+/// Equal-area radius of polar view node `k` (fractional between nodes) of `m` nodes up to
+/// `s_max`: `s_max·k/(m − 1)`.
+fn polar_node(s_max: f32, k: f32, m: usize) -> f32 {
+    s_max * k / (m - 1) as f32
+}
+
 /// View direction of polar node value `s` (equal-area radius) and azimuth `(cos φ, sin φ)`.
 fn view_dir(s: f32, cs: (f32, f32)) -> Vec3 {
     hemisphere::unmap(Vec2::new(s * cs.0, s * cs.1))
@@ -464,7 +455,7 @@ impl BrdfSat {
         let s_max = math::sqrtf(1.0 - math::cosf(theta_max));
         let mut sats = Vec::with_capacity(res.views());
         for k in 0..res.polar {
-            let s = s_max * k as f32 / (res.polar - 1) as f32;
+            let s = polar_node(s_max, k as f32, res.polar);
             for l in 0..res.azimuth {
                 let wo = view_dir(s, azimuth_cs(l, res.azimuth));
                 let t = texel_integrals(brdf, wo, res.grid);
@@ -556,7 +547,7 @@ impl BrdfSat {
                 })
                 .collect()
         };
-        let node_s = |k: f32| self.s_max * k / (m - 1) as f32;
+        let node_s = |k: f32| polar_node(self.s_max, k, m);
         let phi_of = |l: f32| if a <= 1 { 0.0 } else { TWO_PI * l / a as f32 };
         for (q, k) in picks(m, 6).into_iter().enumerate() {
             views.push((node_s(k as f32), phi_of((q % a) as f32), true));
@@ -607,7 +598,7 @@ impl BrdfSat {
                 queries.push(((peak.0 - h + 0.5 * d, peak.1 - 0.2 * h), r));
             }
             for _ in 0..6 {
-                let (rr, t) = (sqrt64(rng.unit()), TWO_PI * rng.unit() as f32);
+                let (rr, t) = (math::sqrt64(rng.unit()), TWO_PI * rng.unit() as f32);
                 let c = (rr * f64::from(math::cosf(t)), rr * f64::from(math::sinf(t)));
                 let r = log_r(rng.unit() as f32);
                 queries.push((c, r));
@@ -631,7 +622,7 @@ impl BrdfSat {
             }
         }
         let rms = if count > 0 {
-            sqrt64(sq / count as f64)
+            math::sqrt64(sq / count as f64)
         } else {
             0.0
         };
@@ -693,6 +684,15 @@ impl BrdfSat {
         self.res
     }
 
+    /// Equal-area radius `s_max = √(1 − cos θ_max)` of the last polar view node: the value
+    /// [`BrdfSat::integral`] divides by to find a view's nodes. Kernels that read the
+    /// tables directly (the SIMD and WGSL shading) take this value rather than recomputing
+    /// it from [`BrdfSat::theta_max`], which need not round-trip bit for bit.
+    #[inline]
+    pub fn s_max(&self) -> f32 {
+        self.s_max
+    }
+
     /// Largest tabulated view polar angle (radians).
     pub fn theta_max(&self) -> f32 {
         let s2 = self.s_max * self.s_max;
@@ -719,7 +719,7 @@ impl BrdfSat {
 
     /// Direction of view node `(k, l)`.
     pub fn view_node(&self, k: usize, l: usize) -> Vec3 {
-        let s = self.s_max * k as f32 / (self.res.polar - 1) as f32;
+        let s = polar_node(self.s_max, k as f32, self.res.polar);
         view_dir(s, azimuth_cs(l, self.res.azimuth))
     }
 }
@@ -760,6 +760,29 @@ mod tests {
         assert!((a - 0.9).abs() < 1e-3, "{a}");
         assert_eq!(t.bytes(), res.bytes());
         assert!(t.fit_report().is_none());
+    }
+
+    #[test]
+    fn s_max_is_the_last_view_nodes_radius() {
+        let res = Resolution {
+            grid: 8,
+            polar: 5,
+            azimuth: 1,
+        };
+        for theta in [
+            0.3f32,
+            1.2,
+            89f32.to_radians(),
+            core::f32::consts::FRAC_PI_2,
+        ] {
+            let t = BrdfSat::build(&Lambert::new(0.5).unwrap(), res, theta).unwrap();
+            let s = t.s_max();
+            assert_eq!(s, math::sqrtf(1.0 - math::cosf(theta)));
+            let last = hemisphere::map(t.view_node(res.polar - 1, 0)).length();
+            assert!((last - s).abs() <= 1e-6 * s, "{theta}: {last} {s}");
+            assert!((t.theta_max() - theta).abs() <= 1e-6, "{theta}");
+            assert_eq!(t.view_node(0, 0), Vec3::Z);
+        }
     }
 
     #[test]

@@ -42,9 +42,11 @@
 //! of eq. 6 (section 6.2), (c) the BRDF SAT's error ([`crate::brdf_sat`]) and (d) the VDT's
 //! error ([`crate::vdt`]). The harness (`harness/src/shade.rs`) measures each against the
 //! `f64` integral of `L·ρ·V` over every environment texel with exact ray-sphere visibility,
-//! by replacing the factors one at a time by their exact values; `harness/tests/shade.rs`
-//! states the relative L2 errors reached (≤ 0.35 % at `K = 30` for the default sky and a
-//! real HDR environment).
+//! by replacing the factors one at a time by their exact values. `harness/tests/shade.rs`
+//! asserts that the kernel's relative L2 error falls with `K` and reports it (Lambert,
+//! `K = 30`: 0.73 % on the default sky, 0.59 % on a real HDR environment; 0.43 % / 0.22 %
+//! at `K = 100`). The paper's 0.35 % at `K = 30` is **not** reached: its two tests are
+//! ignored with the measured values (the report's shading section breaks the error down).
 //!
 //! ## Eq. 13 (section 6.1)
 //!
@@ -70,15 +72,16 @@
 //! below the horizon gives 0 (the cosine-weighted BRDF is 0 there). Nothing panics.
 
 use crate::frame::Frame;
-use crate::rsl::{Rsl, map_extended};
+use crate::math;
+use crate::rsl::{ProjectedSquare, Rsl, map_extended};
 use crate::vdt::VdtView;
 use crate::{Error, Vec2, Vec3};
 
 /// The BRDF factor of eq. 5: `∫_R ρ(wᵢ, wₒ)·cos θᵢ dωᵢ` over the square of the
 /// parametrisation plane with centre `centre` and half-diagonal `half_diagonal` (disk units,
 /// [`crate::hemisphere`]), for the local view `wo_local`. Implemented by the BRDF summed-area
-/// tables (`crate::brdf_sat::BrdfSat`); the harness implements it exactly to measure the
-/// tables' share of the shading error.
+/// tables (`crate::brdf_sat::BrdfSat`); the harness's factor analysis integrates the BRDF
+/// exactly beside it to measure the tables' share of the shading error.
 pub trait BrdfIntegral {
     /// The integral (not the mean: the kernel divides by the light's solid angle).
     fn integral(&self, wo_local: Vec3, centre: Vec2, half_diagonal: f32) -> f32;
@@ -170,17 +173,16 @@ impl SquareVisibility for VdtVisibility<'_> {
     }
 }
 
-/// An RSL prepared for shading: the quantities the kernel needs per light, computed once.
+/// An RSL prepared for shading: the quantities the kernel needs per light, computed once
+/// from a validated [`Rsl`] (the half-diagonal and `1/Ω` are cached so that the hot loop
+/// spends no square root or division on them; the fields are private so that they always
+/// agree with the light's solid angle).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct ShadeLight {
-    /// Unit centre direction (world).
-    pub centre: Vec3,
-    /// Half-diagonal `r = √Ω/2` of the square (disk units).
-    pub half_diagonal: f32,
-    /// `1/Ω`.
-    pub inv_solid_angle: f32,
-    /// Light integral `E = ∫_S L dω`, RGB.
-    pub energy: [f32; 3],
+    centre: Vec3,
+    half_diagonal: f32,
+    inv_solid_angle: f32,
+    energy: [f32; 3],
 }
 
 impl From<&Rsl> for ShadeLight {
@@ -190,6 +192,38 @@ impl From<&Rsl> for ShadeLight {
             half_diagonal: l.half_diagonal(),
             inv_solid_angle: 1.0 / l.solid_angle(),
             energy: l.energy(),
+        }
+    }
+}
+
+impl ShadeLight {
+    /// Unit centre direction (world).
+    #[inline]
+    pub fn centre(&self) -> Vec3 {
+        self.centre
+    }
+    /// Half-diagonal `r = √Ω/2` of the square (disk units, [`Rsl::half_diagonal`]).
+    #[inline]
+    pub fn half_diagonal(&self) -> f32 {
+        self.half_diagonal
+    }
+    /// `1/Ω`.
+    #[inline]
+    pub fn inv_solid_angle(&self) -> f32 {
+        self.inv_solid_angle
+    }
+    /// Light integral `E = ∫_S L dω`, RGB.
+    #[inline]
+    pub fn energy(&self) -> [f32; 3] {
+        self.energy
+    }
+    /// The light's square in the parametrisation of `frame` ([`Rsl::project`] without the
+    /// square root of `Ω`).
+    #[inline]
+    pub fn project(&self, frame: &Frame) -> ProjectedSquare {
+        ProjectedSquare {
+            centre: map_extended(frame.to_local(self.centre)),
+            half_diagonal: self.half_diagonal,
         }
     }
 }
@@ -208,12 +242,11 @@ where
     B: BrdfIntegral + ?Sized,
     V: SquareVisibility + ?Sized,
 {
-    let p = map_extended(frame.to_local(light.centre));
-    let r = light.half_diagonal;
-    // `ProjectedSquare::is_below_horizon` (false for NaN).
-    if p.length() - r >= 1.0 {
+    let sq = light.project(frame);
+    if sq.is_below_horizon() {
         return 0.0;
     }
+    let (p, r) = (sq.centre, sq.half_diagonal);
     let rho = brdf.integral(wo_local, p, r) * light.inv_solid_angle;
     rho * vis.fraction(p, r)
 }
@@ -239,35 +272,6 @@ where
         acc[2] += l.energy[2] * f;
     }
     acc
-}
-
-#[cfg(feature = "std")]
-#[inline]
-fn sqrt64(x: f64) -> f64 {
-    x.sqrt()
-}
-#[cfg(all(not(feature = "std"), feature = "libm"))]
-#[inline]
-fn sqrt64(x: f64) -> f64 {
-    libm::sqrt(x)
-}
-#[cfg(not(any(feature = "std", feature = "libm")))]
-fn sqrt64(x: f64) -> f64 {
-    x
-}
-#[cfg(feature = "std")]
-#[inline]
-fn cbrt64(x: f64) -> f64 {
-    x.cbrt()
-}
-#[cfg(all(not(feature = "std"), feature = "libm"))]
-#[inline]
-fn cbrt64(x: f64) -> f64 {
-    libm::cbrt(x)
-}
-#[cfg(not(any(feature = "std", feature = "libm")))]
-fn cbrt64(x: f64) -> f64 {
-    x
 }
 
 /// Mean, standard deviation and third absolute central moment of a function over a region
@@ -307,8 +311,8 @@ impl Moments {
         }
         Moments {
             mean,
-            sigma: sqrt64(s2 / w),
-            third: cbrt64(s3 / w),
+            sigma: math::sqrt64(s2 / w),
+            third: math::cbrt64(s3 / w),
         }
     }
 }

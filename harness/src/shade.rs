@@ -36,14 +36,14 @@ use glam::{DVec2, DVec3, Vec2, Vec3};
 use steradian_core::brdf::Brdf;
 use steradian_core::brdf_sat::{BrdfSat, FitOptions};
 use steradian_core::frame::Frame;
-use steradian_core::rsl::map_extended;
 use steradian_core::shade::{
-    self, BrdfIntegral, Moments, ShadeLight, VdtQuery, VdtVisibility, multi_product_bound,
+    self, Moments, ShadeLight, VdtQuery, VdtVisibility, multi_product_bound,
 };
 use steradian_core::vdt::Vdt;
 use steradian_core::visibility::{Outside, binary_into, coverage_into, local_cap};
+use steradian_simd::shade::{IsoBrdfTables, ShadeInput, shade_batch};
 
-use crate::env::cubemap::{FACES, rect_solid_angle};
+use crate::env::cubemap::for_each_sub_texel;
 use crate::env::{CubeMap, Decomposition};
 
 /// A sphere (occluder).
@@ -214,34 +214,18 @@ pub struct Samples {
 impl Samples {
     /// `sub × sub` samples per texel of `cube`, in texel order.
     pub fn new(cube: &CubeMap, sub: usize) -> Samples {
-        let n = cube.n();
         let sub = sub.max(1);
-        let h = 2.0 / n as f64;
-        let hs = h / sub as f64;
         let cap = cube.len() * sub * sub;
         let (mut dirs, mut weights, mut texel) = (
             Vec::with_capacity(cap),
             Vec::with_capacity(cap),
             Vec::with_capacity(cap),
         );
-        for (f, (nf, u, v)) in FACES.iter().enumerate() {
-            for j in 0..n {
-                for i in 0..n {
-                    let k = ((f * n + j) * n + i) as u32;
-                    for sj in 0..sub {
-                        let b0 = -1.0 + h * j as f64 + hs * sj as f64;
-                        for si in 0..sub {
-                            let a0 = -1.0 + h * i as f64 + hs * si as f64;
-                            weights.push(rect_solid_angle(a0, a0 + hs, b0, b0 + hs));
-                            dirs.push(
-                                (*nf + *u * (a0 + 0.5 * hs) + *v * (b0 + 0.5 * hs)).normalize(),
-                            );
-                            texel.push(k);
-                        }
-                    }
-                }
-            }
-        }
+        for_each_sub_texel(cube.n(), sub, |k, d, w| {
+            dirs.push(d);
+            weights.push(w);
+            texel.push(k as u32);
+        });
         Samples {
             sub,
             dirs,
@@ -303,36 +287,6 @@ pub fn par_map<T: Sync, R: Send>(items: &[T], f: impl Fn(&T) -> R + Sync) -> Vec
         }
     });
     out.into_iter().flatten().collect()
-}
-
-/// The exact BRDF factor over a square (midpoint rule on `m × m` cells of the square in
-/// the parametrisation plane, the `f32` model, `f64` sums), as a [`BrdfIntegral`]: the
-/// "exact BRDF" swap of the factor analysis.
-pub struct ExactBrdf<'a> {
-    /// The model.
-    pub brdf: &'a (dyn Brdf + Sync),
-    /// Cells per side.
-    pub m: usize,
-}
-
-impl BrdfIntegral for ExactBrdf<'_> {
-    fn integral(&self, wo: Vec3, centre: Vec2, r: f32) -> f32 {
-        let h = f64::from(r) * FRAC_1_SQRT_2;
-        let c = centre.as_dvec2();
-        let step = 2.0 * h / self.m as f64;
-        let mut s = 0.0;
-        for j in 0..self.m {
-            for i in 0..self.m {
-                let q = c + DVec2::new(-h + step * (i as f64 + 0.5), -h + step * (j as f64 + 0.5));
-                if q.length_squared() >= 1.0 {
-                    continue;
-                }
-                let wi = steradian_core::hemisphere::unmap(q.as_vec2());
-                s += f64::from(self.brdf.eval(wi, wo));
-            }
-        }
-        (2.0 * s * step * step) as f32
-    }
 }
 
 /// Exact square means for one point and one light, `f64`:
@@ -435,8 +389,10 @@ impl Default for Settings {
     }
 }
 
-/// Per-region `L` moments (point independent): `|S|`, `E`, and per-channel moments.
+/// Per-region data (point independent): the samples in the region, `|S|`, `E`, and the
+/// per-channel moments of `L`.
 struct RegionL {
+    members: Vec<usize>,
     area: f64,
     energy: [f64; 3],
     moments: [Moments; 3],
@@ -449,7 +405,7 @@ fn region_l(cube: &CubeMap, samples: &Samples, d: &Decomposition) -> Vec<RegionL
         members[d.region_of[t as usize] as usize].push(s);
     }
     members
-        .iter()
+        .into_iter()
         .map(|ms| {
             let area: f64 = ms.iter().map(|&s| samples.weights[s]).sum();
             let mut energy = [0.0; 3];
@@ -464,6 +420,7 @@ fn region_l(cube: &CubeMap, samples: &Samples, d: &Decomposition) -> Vec<RegionL
                 Moments::of_weighted(it)
             });
             RegionL {
+                members: ms,
                 area,
                 energy,
                 moments,
@@ -538,62 +495,33 @@ pub fn analyse(setup: &Setup<'_>, decs: &[&Decomposition], settings: Settings) -
         let vis_g = VdtVisibility::new(vdt, VdtQuery::Gradient).expect("square VDT");
         let vis_9 = VdtVisibility::new(vdt, VdtQuery::Eq9).expect("square VDT");
         let mut out = Vec::with_capacity(decs.len());
-        for (di, d) in decs.iter().enumerate() {
-            let k = d.regions.len();
-            // Region means of ρ and V, then their moments.
-            let mut sr = vec![0.0f64; k];
-            let mut sv = vec![0.0f64; k];
-            for s in 0..ns {
-                let r = d.region_of[setup.samples.texel[s] as usize] as usize;
-                let w = setup.samples.weights[s];
-                sr[r] += w * rho[s];
-                sv[r] += w * vis[s];
-            }
-            let rl = &regions[di];
-            let ur: Vec<f64> = (0..k).map(|r| sr[r] / rl[r].area).collect();
-            let uv: Vec<f64> = (0..k).map(|r| sv[r] / rl[r].area).collect();
-            let mut m2 = vec![[0.0f64; 2]; k];
-            let mut m3 = vec![[0.0f64; 2]; k];
-            for s in 0..ns {
-                let r = d.region_of[setup.samples.texel[s] as usize] as usize;
-                let w = setup.samples.weights[s];
-                let (dr, dv) = (rho[s] - ur[r], vis[s] - uv[r]);
-                m2[r][0] += w * dr * dr;
-                m2[r][1] += w * dv * dv;
-                m3[r][0] += w * (dr * dr * dr).abs();
-                m3[r][1] += w * (dv * dv * dv).abs();
-            }
+        for (regions, lights) in regions.iter().zip(&lights) {
             let mut res = PointResult {
                 values: vec![[0.0; 3]; VARIANTS.len()],
                 bound: [0.0; 3],
             };
-            for r in 0..k {
-                let a = rl[r].area;
-                let mr = Moments {
-                    mean: ur[r],
-                    sigma: (m2[r][0] / a).sqrt(),
-                    third: (m3[r][0] / a).cbrt(),
+            for rl in regions {
+                // Moments of ρ and V over the region (solid-angle weights).
+                let of = |f: &[f64]| {
+                    Moments::of_weighted(
+                        rl.members.iter().map(|&s| (f[s], setup.samples.weights[s])),
+                    )
                 };
-                let mv = Moments {
-                    mean: uv[r],
-                    sigma: (m2[r][1] / a).sqrt(),
-                    third: (m3[r][1] / a).cbrt(),
-                };
+                let (mr, mv) = (of(&rho), of(&vis));
                 for c in 0..3 {
-                    res.values[0][c] += rl[r].energy[c] * ur[r] * uv[r];
-                    res.bound[c] += multi_product_bound(a, &rl[r].moments[c], &mv, &mr);
+                    res.values[0][c] += rl.energy[c] * mr.mean * mv.mean;
+                    res.bound[c] += multi_product_bound(rl.area, &rl.moments[c], &mv, &mr);
                 }
             }
             // Squares.
-            let frame = &p.frame;
-            for l in &lights[di] {
-                let pc = map_extended(frame.to_local(l.centre));
-                let r = l.half_diagonal;
-                if pc.length() - r >= 1.0 {
+            for l in lights {
+                let sq = l.project(&p.frame);
+                if sq.is_below_horizon() {
                     continue;
                 }
-                let e = l.energy.map(f64::from);
-                let sat = f64::from(setup.sat.integral(wo, pc, r) * l.inv_solid_angle);
+                let (pc, r) = (sq.centre, sq.half_diagonal);
+                let e = l.energy().map(f64::from);
+                let sat = f64::from(setup.sat.integral(wo, pc, r) * l.inv_solid_angle());
                 let vg = f64::from(shade::SquareVisibility::fraction(&vis_g, pc, r));
                 let v9 = f64::from(shade::SquareVisibility::fraction(&vis_9, pc, r));
                 let mut f = [0.0f64; 7];
@@ -627,19 +555,21 @@ pub fn analyse(setup: &Setup<'_>, decs: &[&Decomposition], settings: Settings) -
     Analysis { reference, results }
 }
 
-/// The kernel itself at every point ([`shade::shade`], gradient VDT), `f32` RGB.
+/// The kernel itself at every point ([`shade::shade`], point `i` with VDT `i` queried by
+/// `query`), `f32` RGB.
 pub fn shade_points(
     scene: &Scene,
     sat: &BrdfSat,
     vdts: &[Vdt],
     lights: &[ShadeLight],
+    query: VdtQuery,
 ) -> Vec<[f32; 3]> {
     scene
         .points
         .iter()
         .zip(vdts)
         .map(|(p, v)| {
-            let vis = VdtVisibility::new(v.view(), VdtQuery::Gradient).expect("square VDT");
+            let vis = VdtVisibility::new(v.view(), query).expect("square VDT");
             shade::shade(&p.frame, p.wo, sat, &vis, lights)
         })
         .collect()
@@ -692,18 +622,30 @@ pub fn fit_sat(brdf: &dyn Brdf, decs: &[&Decomposition], target: f32) -> BrdfSat
     BrdfSat::fit(brdf, &o).expect("valid fit options")
 }
 
-/// The isotropic BRDF SAT as the SIMD kernel reads it: the polar tables' views and
-/// `s_max = sqrt(1 − cos θ_max)`. `None` for an anisotropic table.
-pub fn iso_views(sat: &BrdfSat) -> Option<(Vec<steradian_core::sat::SatView<'_>>, f32)> {
+/// The polar tables of an isotropic BRDF SAT as the SIMD and WGSL kernels read them
+/// (with [`BrdfSat::s_max`]). `None` for an anisotropic table.
+pub fn iso_views(sat: &BrdfSat) -> Option<Vec<steradian_core::sat::SatView<'_>>> {
     let res = sat.resolution();
     if res.azimuth != 1 {
         return None;
     }
-    let views = (0..res.polar)
+    (0..res.polar)
         .map(|k| sat.table(k, 0).map(|t| t.view()))
-        .collect::<Option<Vec<_>>>()?;
-    let s_max = (1.0 - sat.theta_max().cos()).sqrt();
-    Some((views, s_max))
+        .collect()
+}
+
+/// The SIMD kernel's inputs: every point with its VDT (point `i` uses VDT `i`).
+pub fn simd_inputs<'a>(scene: &Scene, vdts: &'a [Vdt]) -> Vec<ShadeInput<'a>> {
+    scene
+        .points
+        .iter()
+        .zip(vdts)
+        .map(|(p, v)| ShadeInput {
+            frame: p.frame,
+            wo: p.wo,
+            vdt: v.view(),
+        })
+        .collect()
 }
 
 /// The SIMD kernel at every point (`steradian_simd::shade::shade_batch`).
@@ -714,22 +656,12 @@ pub fn shade_points_simd(
     lights: &[ShadeLight],
     query: VdtQuery,
 ) -> Option<Vec<[f32; 3]>> {
-    use steradian_simd::shade::{IsoBrdfTables, ShadeInput, shade_batch};
-    let (views, s_max) = iso_views(sat)?;
+    let views = iso_views(sat)?;
     let tables = IsoBrdfTables {
         tables: &views,
-        s_max,
+        s_max: sat.s_max(),
     };
-    let inputs: Vec<ShadeInput<'_>> = scene
-        .points
-        .iter()
-        .zip(vdts)
-        .map(|(p, v)| ShadeInput {
-            frame: p.frame,
-            wo: p.wo,
-            vdt: v.view(),
-        })
-        .collect();
+    let inputs = simd_inputs(scene, vdts);
     let mut out = vec![[0.0f32; 3]; inputs.len()];
     shade_batch(&inputs, &tables, query, lights, &mut out).then_some(out)
 }
@@ -742,7 +674,7 @@ pub fn gpu_table(
     lights: &[ShadeLight],
     query: VdtQuery,
 ) -> Option<Vec<f32>> {
-    let (views, s_max) = iso_views(sat)?;
+    let views = iso_views(sat)?;
     let grid = sat.resolution().grid;
     let vn = vdts.first().map_or(1, |v| v.width());
     if vdts.iter().any(|v| v.width() != vn || v.height() != vn) {
@@ -757,7 +689,7 @@ pub fn gpu_table(
         lights.len() as u32,
         grid as u32,
         views.len() as u32,
-        s_max.to_bits(),
+        sat.s_max().to_bits(),
         vn as u32,
         off_lights as u32,
         off_brdf as u32,
@@ -765,16 +697,17 @@ pub fn gpu_table(
         (query == VdtQuery::Gradient) as u32,
     ];
     for l in lights {
+        let (c, e) = (l.centre(), l.energy());
         w.extend(
             [
-                l.centre.x,
-                l.centre.y,
-                l.centre.z,
-                l.half_diagonal,
-                l.inv_solid_angle,
-                l.energy[0],
-                l.energy[1],
-                l.energy[2],
+                c.x,
+                c.y,
+                c.z,
+                l.half_diagonal(),
+                l.inv_solid_angle(),
+                e[0],
+                e[1],
+                e[2],
             ]
             .map(f32::to_bits),
         );

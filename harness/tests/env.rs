@@ -16,15 +16,6 @@ use steradian_harness::env::decompose::{
 use steradian_harness::env::{self, CubeMap, EnvError, Equirect, Sky};
 use steradian_harness::rng::Rng;
 
-fn opts(ks: &[usize]) -> Options {
-    Options {
-        ks: ks.to_vec(),
-        cross_face: true,
-        progress: false,
-        objective: Objective::Bound,
-    }
-}
-
 fn real() -> CubeMap {
     env::load_cubemap(&env::real_env_path(), 32).expect("harness/data/sky.exr")
 }
@@ -222,13 +213,11 @@ fn rejects_bad_environments() {
     assert!(CubeMap::new(1, vec![[1.0, -1.0, 0.0]; 6]).is_err());
     let cube = random_env(4, 1);
     for ks in [vec![], vec![0], vec![97]] {
-        assert!(decompose(&cube, &opts(&ks)).is_err(), "{ks:?}");
+        assert!(decompose(&cube, &Options::quiet(&ks)).is_err(), "{ks:?}");
     }
     let same_face = Options {
-        ks: vec![5],
         cross_face: false,
-        progress: false,
-        objective: Objective::Bound,
+        ..Options::quiet(&[5])
     };
     assert!(decompose(&cube, &same_face).is_err());
 }
@@ -272,7 +261,7 @@ fn check_partition(cube: &CubeMap, d: &Decomposition) {
 #[test]
 fn every_texel_in_exactly_one_connected_region() {
     let cube = env::default_sky(16).unwrap();
-    for d in decompose(&cube, &opts(&[100, 30, 10])).unwrap() {
+    for d in decompose(&cube, &Options::quiet(&[100, 30, 10])).unwrap() {
         check_partition(&cube, &d);
     }
     let same_face = Options {
@@ -294,7 +283,7 @@ fn every_texel_in_exactly_one_connected_region() {
 fn k_is_respected() {
     let cube = random_env(8, 3);
     let ks = [384, 383, 100, 37, 10, 2, 1];
-    let ds = decompose(&cube, &opts(&ks)).unwrap();
+    let ds = decompose(&cube, &Options::quiet(&ks)).unwrap();
     assert_eq!(ds.len(), ks.len());
     for (d, k) in ds.iter().zip(ks) {
         assert_eq!(d.k, k);
@@ -321,7 +310,7 @@ fn decomposition_preserves_total_energy() {
         ("real", real()),
     ] {
         let total = cube.integral();
-        for d in decompose(&cube, &opts(&[100, 60, 30, 10])).unwrap() {
+        for d in decompose(&cube, &Options::quiet(&[100, 60, 30, 10])).unwrap() {
             let mut sum = [0.0f64; 3];
             let mut sum32 = [0.0f64; 3];
             for (r, l) in d.regions.iter().zip(d.rsls().unwrap()) {
@@ -349,8 +338,8 @@ fn decomposition_preserves_total_energy() {
 #[test]
 fn decomposition_is_deterministic() {
     let cube = real();
-    let a = decompose(&cube, &opts(&[30, 10])).unwrap();
-    let b = decompose(&cube, &opts(&[30, 10])).unwrap();
+    let a = decompose(&cube, &Options::quiet(&[30, 10])).unwrap();
+    let b = decompose(&cube, &Options::quiet(&[30, 10])).unwrap();
     for (x, y) in a.iter().zip(&b) {
         assert_eq!(x.region_of, y.region_of);
         for (r, s) in x.regions.iter().zip(&y.regions) {
@@ -370,8 +359,11 @@ fn priority_queue_matches_the_figure_5_rescan() {
         (CubeMap::new(4, vec![[1.0; 3]; 96]).unwrap(), 9, true),
     ] {
         for objective in [Objective::Paper, Objective::Bound] {
-            let mut o = opts(&[k]).with_cross(cross);
-            o.objective = objective;
+            let o = Options {
+                cross_face: cross,
+                objective,
+                ..Options::quiet(&[k])
+            };
             let fast = &decompose(&cube, &o).unwrap()[0];
             let slow = decompose_rescan(&cube, k, cross, objective).unwrap();
             assert_eq!(
@@ -382,16 +374,6 @@ fn priority_queue_matches_the_figure_5_rescan() {
     }
 }
 
-trait WithCross {
-    fn with_cross(self, cross: bool) -> Self;
-}
-impl WithCross for Options {
-    fn with_cross(mut self, cross: bool) -> Self {
-        self.cross_face = cross;
-        self
-    }
-}
-
 #[test]
 fn fit_error_decreases_with_k() {
     for (name, cube) in [
@@ -399,8 +381,10 @@ fn fit_error_decreases_with_k() {
         ("real", real()),
     ] {
         for objective in [Objective::Paper, Objective::Bound] {
-            let mut o = opts(&[100, 60, 30, 10]);
-            o.objective = objective;
+            let o = Options {
+                objective,
+                ..Options::quiet(&[100, 60, 30, 10])
+            };
             let ds = decompose(&cube, &o).unwrap();
             let pw: Vec<f64> = ds.iter().map(|d| d.piecewise_rel_l2(&cube)).collect();
             let eta: Vec<f64> = ds.iter().map(|d| d.rsl_rel_l2()).collect();
@@ -443,7 +427,7 @@ fn decomposition_of_6x32x32_takes_seconds() {
     // minutes; a rescan per merge would need hours at this size.
     let cube = env::default_sky(32).unwrap();
     let t = std::time::Instant::now();
-    let ds = decompose(&cube, &opts(&[10])).unwrap();
+    let ds = decompose(&cube, &Options::quiet(&[10])).unwrap();
     let s = t.elapsed().as_secs_f64();
     println!("6 × 32 × 32 → 10 RSLs in {s:.2} s");
     assert_eq!(ds[0].regions.len(), 10);
@@ -484,7 +468,7 @@ fn fit_of_simple_regions() {
 fn regions_expose_what_shading_needs() {
     let cube = env::default_sky(32).unwrap();
     let sky = Sky::default();
-    let d = &decompose(&cube, &opts(&[30])).unwrap()[0];
+    let d = &decompose(&cube, &Options::quiet(&[30])).unwrap()[0];
     let rsls = d.rsls().unwrap();
     let sun_texel = cube.dir_to_texel(sky.sun_dir);
     let sun_region = d.region_of[sun_texel] as usize;
@@ -667,8 +651,10 @@ fn bound_objective_is_the_default_and_splits_large_regions() {
     assert_eq!(Options::default().objective, Objective::Bound);
     let cube = env::default_sky(32).unwrap();
     let largest = |objective| {
-        let mut o = opts(&[30]);
-        o.objective = objective;
+        let o = Options {
+            objective,
+            ..Options::quiet(&[30])
+        };
         let d = decompose(&cube, &o).unwrap();
         assert_eq!(d[0].merge, objective);
         d[0].regions

@@ -11,7 +11,6 @@
 
 #![allow(clippy::needless_range_loop)] // RGB channels are indexed in parallel arrays
 
-use std::io::Write;
 use std::sync::OnceLock;
 use std::time::Instant;
 
@@ -19,15 +18,15 @@ use steradian_core::brdf::{Brdf, Lambert, Phong};
 use steradian_core::brdf_sat::BrdfSat;
 use steradian_core::shade::{ShadeLight, VdtQuery};
 use steradian_core::vdt::Vdt;
-use steradian_harness::backend::gpu::{Custom, Gpu, gpu_required, try_gpu};
-use steradian_harness::env::decompose::{Decomposition, Objective, Options, decompose};
+use steradian_harness::backend::gpu::Custom;
+use steradian_harness::env::decompose::{Decomposition, Options, PAPER_KS, decompose};
 use steradian_harness::env::{self, CubeMap};
 use steradian_harness::kernels::Columns;
 use steradian_harness::shade::{self as sh, Analysis, Samples, Scene, Settings, VARIANTS, Variant};
 
-fn say(line: &str) {
-    let _ = writeln!(std::io::stderr(), "{line}");
-}
+#[path = "common/gpu.rs"]
+mod gpu_common;
+use gpu_common::{gpu, say};
 
 /// VDT resolution of the accuracy tests (the report measures 64, 128, 256).
 const VDT_N: usize = 256;
@@ -44,16 +43,7 @@ struct Env {
 
 fn build(name: &'static str, cube: CubeMap) -> Env {
     let t0 = Instant::now();
-    let mut decs = decompose(
-        &cube,
-        &Options {
-            ks: vec![10, 30, 60, 100],
-            cross_face: true,
-            progress: false,
-            objective: Objective::Bound,
-        },
-    )
-    .expect("decomposition");
+    let mut decs = decompose(&cube, &Options::quiet(&PAPER_KS)).expect("decomposition");
     decs.reverse(); // K ascending
     let refs: Vec<&Decomposition> = decs.iter().collect();
     let brdf = Lambert::new(0.8).unwrap();
@@ -220,16 +210,7 @@ struct Small {
 
 fn small(glossy: bool) -> Small {
     let cube = env::default_sky(16).unwrap();
-    let decs = decompose(
-        &cube,
-        &Options {
-            ks: vec![30],
-            cross_face: true,
-            progress: false,
-            objective: Objective::Bound,
-        },
-    )
-    .unwrap();
+    let decs = decompose(&cube, &Options::quiet(&[30])).unwrap();
     let lights: Vec<ShadeLight> = decs[0]
         .rsls()
         .unwrap()
@@ -261,7 +242,7 @@ fn close(a: [f32; 3], b: [f32; 3], tol: f32) -> bool {
 #[test]
 fn kernel_matches_the_analysis_pipeline() {
     let s = small(false);
-    let scalar = sh::shade_points(&s.scene, &s.sat, &s.vdts, &s.lights);
+    let scalar = sh::shade_points(&s.scene, &s.sat, &s.vdts, &s.lights, VdtQuery::Gradient);
     for (p, v) in scalar.iter().enumerate() {
         let pt = &s.scene.points[p];
         let vis = steradian_core::shade::VdtVisibility::new(s.vdts[p].view(), VdtQuery::Gradient)
@@ -271,7 +252,7 @@ fn kernel_matches_the_analysis_pipeline() {
         for l in &s.lights {
             let f = steradian_core::shade::light_factor(&pt.frame, wo, &s.sat, &vis, l);
             for c in 0..3 {
-                acc[c] += f64::from(l.energy[c]) * f64::from(f);
+                acc[c] += f64::from(l.energy()[c]) * f64::from(f);
             }
         }
         assert!(close(*v, acc.map(|x| x as f32), 1e-5), "{p}: {v:?} {acc:?}");
@@ -283,16 +264,7 @@ fn simd_matches_scalar_lane_by_lane() {
     for glossy in [false, true] {
         let s = small(glossy);
         for q in [VdtQuery::Gradient, VdtQuery::Eq9] {
-            let scalar: Vec<[f32; 3]> = s
-                .scene
-                .points
-                .iter()
-                .zip(&s.vdts)
-                .map(|(p, v)| {
-                    let vis = steradian_core::shade::VdtVisibility::new(v.view(), q).unwrap();
-                    steradian_core::shade::shade(&p.frame, p.wo, &s.sat, &vis, &s.lights)
-                })
-                .collect();
+            let scalar = sh::shade_points(&s.scene, &s.sat, &s.vdts, &s.lights, q);
             let simd = sh::shade_points_simd(&s.scene, &s.sat, &s.vdts, &s.lights, q).unwrap();
             let mut worst = 0.0f32;
             for (p, (a, b)) in scalar.iter().zip(&simd).enumerate() {
@@ -308,22 +280,6 @@ fn simd_matches_scalar_lane_by_lane() {
             say(&format!(
                 "SIMD vs scalar (glossy {glossy}, {q:?}): largest relative difference {worst:.2e}"
             ));
-        }
-    }
-}
-
-fn gpu() -> Option<Gpu> {
-    match try_gpu() {
-        Ok(g) => {
-            say(&format!("GPU tests ran on adapter: {}", g.adapter_info()));
-            Some(g)
-        }
-        Err(reason) => {
-            if gpu_required() {
-                panic!("STERADIAN_REQUIRE_GPU=1 but no GPU backend: {reason}");
-            }
-            say(&format!("GPU tests skipped: {reason}"));
-            None
         }
     }
 }
@@ -360,10 +316,9 @@ fn gpu_matches_scalar() {
             };
             g.run_custom(&custom, &input, &mut out)
                 .expect("shade kernel runs");
+            let scalar = sh::shade_points(&s.scene, &s.sat, &s.vdts, &s.lights, q);
             let mut worst = 0.0f32;
-            for (p, (pt, v)) in s.scene.points.iter().zip(&s.vdts).enumerate() {
-                let vis = steradian_core::shade::VdtVisibility::new(v.view(), q).unwrap();
-                let a = steradian_core::shade::shade(&pt.frame, pt.wo, &s.sat, &vis, &s.lights);
+            for (p, &a) in scalar.iter().enumerate() {
                 let b = [0, 1, 2].map(|c| out.data[c * input.n + p]);
                 let m = a.iter().fold(0.0f32, |m, x| m.max(x.abs()));
                 for c in 0..3 {
@@ -379,203 +334,6 @@ fn gpu_matches_scalar() {
             ));
         }
     }
-}
-
-fn explore_env(
-    name: &str,
-    cube: &CubeMap,
-    brdf: &(dyn Brdf + Sync),
-    vdt_n: usize,
-    sub: usize,
-    g: usize,
-) {
-    let t0 = Instant::now();
-    let decs = decompose(
-        cube,
-        &Options {
-            ks: vec![10, 30, 60, 100],
-            cross_face: true,
-            progress: false,
-            objective: Objective::Bound,
-        },
-    )
-    .unwrap();
-    let decs: Vec<_> = decs.iter().rev().collect();
-    let scene = Scene::standard(g);
-    let t1 = Instant::now();
-    let sat = sh::fit_sat(brdf, &decs, 0.005);
-    say(&format!(
-        "{name}: decomposed in {:?}, sat {:?} {:?} in {:?}",
-        t1 - t0,
-        sat.resolution(),
-        sat.fit_report().map(|f| (f.max_error, f.met)),
-        t1.elapsed()
-    ));
-    let t2 = Instant::now();
-    let vdts: Vec<_> = scene
-        .points
-        .iter()
-        .map(|p| sh::point_vdt(&scene, p, vdt_n))
-        .collect();
-    say(&format!(
-        "{} points, vdts {vdt_n} in {:?}",
-        scene.points.len(),
-        t2.elapsed()
-    ));
-    let samples = Samples::new(cube, sub);
-    let t3 = Instant::now();
-    let setup = sh::Setup {
-        cube,
-        samples: &samples,
-        scene: &scene,
-        brdf,
-        sat: &sat,
-        vdts: &vdts,
-    };
-    let a = sh::analyse(&setup, &decs, Settings::default());
-    say(&format!("analysis in {:?}", t3.elapsed()));
-    for (di, d) in decs.iter().enumerate() {
-        let mut line = format!("K={:3}", d.k);
-        for v in VARIANTS {
-            line += &format!(" {:?}={:.3}%", v, 100.0 * a.error(di, v));
-        }
-        line += &format!(" bound={:.3}%", 100.0 * a.bound(di));
-        say(&line);
-    }
-}
-
-#[test]
-#[ignore]
-fn explore() {
-    let vdt_n: usize = std::env::var("VDT_N")
-        .ok()
-        .and_then(|s| s.parse().ok())
-        .unwrap_or(64);
-    let sub: usize = std::env::var("SUB")
-        .ok()
-        .and_then(|s| s.parse().ok())
-        .unwrap_or(SUB);
-    let g: usize = std::env::var("G")
-        .ok()
-        .and_then(|s| s.parse().ok())
-        .unwrap_or(12);
-    let sky = env::default_sky(32).unwrap();
-    let lam = Lambert::new(0.8).unwrap();
-    let phong = Phong::new(0.3, 0.5, 30.0).unwrap();
-    if std::env::var("ONLY_PHONG").is_err() {
-        explore_env("sky lambert", &sky, &lam, vdt_n, sub, g);
-    }
-    explore_env("sky phong", &sky, &phong, vdt_n, sub, g);
-    if std::env::var("ONLY_PHONG").is_ok() {
-        return;
-    }
-    let real = env::load_cubemap(&env::real_env_path(), 32).unwrap();
-    explore_env("exr lambert", &real, &lam, vdt_n, sub, g);
-    explore_env("exr phong", &real, &phong, vdt_n, sub, g);
-    let _ = Variant::Kernel;
-}
-
-#[test]
-#[ignore]
-fn explore_points() {
-    let which = std::env::var("ENV").unwrap_or_default();
-    let cube = if which == "exr" {
-        env::load_cubemap(&env::real_env_path(), 32).unwrap()
-    } else {
-        env::default_sky(32).unwrap()
-    };
-    let brdf = Lambert::new(0.8).unwrap();
-    let decs = decompose(
-        &cube,
-        &Options {
-            ks: vec![30],
-            cross_face: true,
-            progress: false,
-            objective: Objective::Bound,
-        },
-    )
-    .unwrap();
-    let d = &decs[0];
-    let tot: f64 = d.regions.iter().map(|r| r.luminance_energy).sum();
-    let mut regs: Vec<_> = d.regions.iter().enumerate().collect();
-    regs.sort_by(|a, b| b.1.luminance_energy.total_cmp(&a.1.luminance_energy));
-    for (i, r) in regs.iter().take(8) {
-        say(&format!(
-            "region {i}: {} texels, |S| {:.4} sr, square {:.4} sr, energy {:.3} ({:.1}%), c {:?}",
-            r.texels.len(),
-            r.solid_angle,
-            r.fit.solid_angle,
-            r.luminance_energy,
-            100.0 * r.luminance_energy / tot,
-            r.fit.centre
-        ));
-    }
-    let scene = Scene::standard(12);
-    let decs: Vec<_> = decs.iter().collect();
-    let sat = sh::fit_sat(&brdf, &decs, 0.005);
-    let vdts: Vec<_> = scene
-        .points
-        .iter()
-        .map(|p| sh::point_vdt(&scene, p, 64))
-        .collect();
-    let samples = Samples::new(&cube, SUB);
-    let setup = sh::Setup {
-        cube: &cube,
-        samples: &samples,
-        scene: &scene,
-        brdf: &brdf,
-        sat: &sat,
-        vdts: &vdts,
-    };
-    let a = sh::analyse(&setup, &decs, Settings::default());
-    let den: f64 = a
-        .reference
-        .iter()
-        .map(|r| r.iter().map(|x| x * x).sum::<f64>())
-        .sum();
-    for v in [0usize, 1, 2, 4] {
-        let mut errs: Vec<(f64, usize)> = a.results[0]
-            .iter()
-            .zip(&a.reference)
-            .enumerate()
-            .map(|(p, (r, x))| {
-                (
-                    (0..3).map(|c| (r.values[v][c] - x[c]).powi(2)).sum::<f64>() / den,
-                    p,
-                )
-            })
-            .collect();
-        errs.sort_by(|a, b| b.0.total_cmp(&a.0));
-        let tot: f64 = errs.iter().map(|e| e.0).sum();
-        say(&format!(
-            "variant {:?}: total {:.3}%",
-            VARIANTS[v],
-            100.0 * tot.sqrt()
-        ));
-        for (e, p) in errs.iter().take(6) {
-            let pt = &scene.points[*p];
-            say(&format!(
-                "  point {p} pos {:.2?} n {:.2?}: share {:.1}% ref {:.3?} got {:.3?}",
-                pt.pos,
-                pt.frame.normal(),
-                100.0 * e / tot,
-                a.reference[*p],
-                a.results[0][*p].values[v]
-            ));
-        }
-    }
-}
-
-#[test]
-#[ignore]
-fn explore_nosun() {
-    let s = env::Sky {
-        sun_energy: [0.0; 3],
-        ..Default::default()
-    };
-    let cube = s.cubemap(32).unwrap();
-    let lam = Lambert::new(0.8).unwrap();
-    explore_env("nosun lambert", &cube, &lam, 256, 2, 12);
 }
 
 /// The report section alone (`cargo test --release -p steradian-harness --test shade

@@ -12,11 +12,13 @@
 //!
 //! **Accuracy against the scalar kernel.** Not bit-identical: the map is computed without
 //! the scalar kernel's overflow-safe rescaling (the light centres and frames are unit, so
-//! nothing overflows), and the view's table interpolation constants use `s_max` as given by
-//! the caller. Per light the factor `ρ̄·V̄` agrees with the scalar one to a few `f32` ulps of
+//! nothing overflows). The view's table interpolation constants are the scalar kernel's
+//! operations on the same `s_max` (pass `BrdfSat::s_max`, not a value recomputed from
+//! `θ_max`). Per light the factor `ρ̄·V̄` agrees with the scalar one to a few `f32` ulps of
 //! the square's coordinates, which moves a VDT query near a steep edge by up to
-//! `~1e-6/r` relative; `simd/tests` and the harness test `simd_matches_scalar_lane_by_lane`
-//! check [`REL_TOL`] per channel (relative to the point's largest channel).
+//! `~1e-6/r` relative; the harness test `simd_matches_scalar_lane_by_lane` (which owns the
+//! BRDF SATs and VDTs) checks [`REL_TOL`] per channel (relative to the point's largest
+//! channel).
 //!
 //! **Bad input.** Never panics for validated tables; NaN in the frames or views gives NaN
 //! in that lane.
@@ -34,12 +36,12 @@ pub const REL_TOL: f32 = 2.0e-5;
 
 /// An isotropic BRDF SAT as the SIMD kernel reads it: the tables of the polar view nodes
 /// `k = 0..m` (`BrdfSat::table(k, 0)`), all of the same size, and `s_max`, the equal-area
-/// radius of the last node (`sqrt(1 − cos θ_max)`).
+/// radius of the last node (`BrdfSat::s_max`).
 #[derive(Clone, Copy, Debug)]
 pub struct IsoBrdfTables<'a> {
     /// The tables, one per polar node (at least 2).
     pub tables: &'a [SatView<'a>],
-    /// Equal-area radius of the last node.
+    /// Equal-area radius of the last node (`BrdfSat::s_max`).
     pub s_max: f32,
 }
 
@@ -306,7 +308,7 @@ pub fn shade_x8(
     let one = f32x8::ONE;
     let mut acc = [f32x8::ZERO; 3];
     for l in lights {
-        let c = l.centre;
+        let c = l.centre();
         let x = fr[0][0] * c.x + fr[0][1] * c.y + fr[0][2] * c.z;
         let y = fr[1][0] * c.x + fr[1][1] * c.y + fr[1][2] * c.z;
         let z = fr[2][0] * c.x + fr[2][1] * c.y + fr[2][2] * c.z;
@@ -328,7 +330,7 @@ pub fn shade_x8(
             f32x8::splat(core::f32::consts::SQRT_2),
         );
         let py = y * k;
-        let r = f32x8::splat(l.half_diagonal);
+        let r = f32x8::splat(l.half_diagonal());
         let live = ((px * px + py * py).sqrt() - r).simd_lt(one) & front;
         if !live.any() {
             continue;
@@ -340,7 +342,7 @@ pub fn shade_x8(
         let tcy = (qy + one) * half_b;
         let h = r * half_b * f32x8::splat(core::f32::consts::FRAC_1_SQRT_2);
         let (v0, v1) = box_pair(tabs, &views, (tcx - h, tcy - h, tcx + h, tcy + h), bw, bh);
-        let rho = (v0 + tw * (v1 - v0)) * f32x8::splat(l.inv_solid_angle);
+        let rho = (v0 + tw * (v1 - v0)) * f32x8::splat(l.inv_solid_angle());
         let vis = vdt_lanes(
             &vdts,
             n,
@@ -350,8 +352,8 @@ pub fn shade_x8(
             query,
         );
         let f = sel(live, rho * vis, f32x8::ZERO) + nan;
-        for (ch, a) in acc.iter_mut().enumerate() {
-            *a += f32x8::splat(l.energy[ch]) * f;
+        for (a, e) in acc.iter_mut().zip(l.energy()) {
+            *a += f32x8::splat(e) * f;
         }
     }
     let acc = acc.map(|a| sel(front, a, f32x8::ZERO) + nan);

@@ -72,6 +72,34 @@ pub fn dir_to_face(d: DVec3) -> (usize, f64, f64) {
     (f, d.dot(u) / m, d.dot(v) / m)
 }
 
+/// Visits the `sub × sub` sub-texels of every texel of a `6 × n × n` cube map, in flat
+/// texel order and row-major within a texel: `visit(texel, dir, solid_angle)` with the unit
+/// direction through the sub-texel's centre and its exact solid angle. The one place that
+/// splits texels (box filtering in [`CubeMap::from_fn`], the shading reference's samples).
+pub fn for_each_sub_texel(n: usize, sub: usize, mut visit: impl FnMut(usize, DVec3, f64)) {
+    let sub = sub.max(1);
+    let h = 2.0 / n.max(1) as f64;
+    let hs = h / sub as f64;
+    for f in 0..6 {
+        for j in 0..n {
+            for i in 0..n {
+                let k = (f * n + j) * n + i;
+                for sj in 0..sub {
+                    let b0 = -1.0 + h * j as f64 + hs * sj as f64;
+                    for si in 0..sub {
+                        let a0 = -1.0 + h * i as f64 + hs * si as f64;
+                        visit(
+                            k,
+                            face_dir(f, a0 + 0.5 * hs, b0 + 0.5 * hs),
+                            rect_solid_angle(a0, a0 + hs, b0, b0 + hs),
+                        );
+                    }
+                }
+            }
+        }
+    }
+}
+
 /// A cube map of RGB radiance.
 #[derive(Clone, Debug)]
 pub struct CubeMap {
@@ -133,32 +161,19 @@ impl CubeMap {
         sub: usize,
         f: impl Fn(DVec3) -> [f64; 3],
     ) -> Result<CubeMap, EnvError> {
-        let sub = sub.max(1);
-        let h = 2.0 / n.max(1) as f64;
-        let hs = h / sub as f64;
-        let mut texels = Vec::with_capacity(6 * n * n);
-        for face in 0..6 {
-            for j in 0..n {
-                for i in 0..n {
-                    let mut acc = [0.0f64; 3];
-                    let mut w = 0.0;
-                    for sj in 0..sub {
-                        let b0 = -1.0 + h * j as f64 + hs * sj as f64;
-                        for si in 0..sub {
-                            let a0 = -1.0 + h * i as f64 + hs * si as f64;
-                            let om = rect_solid_angle(a0, a0 + hs, b0, b0 + hs);
-                            let v = f(face_dir(face, a0 + 0.5 * hs, b0 + 0.5 * hs));
-                            for c in 0..3 {
-                                acc[c] += v[c] * om;
-                            }
-                            w += om;
-                        }
-                    }
-                    texels.push(acc.map(|a| (a / w) as f32));
-                }
+        let mut acc = vec![([0.0f64; 3], 0.0f64); 6 * n * n];
+        for_each_sub_texel(n, sub, |k, d, om| {
+            let v = f(d);
+            let (sum, w) = &mut acc[k];
+            for c in 0..3 {
+                sum[c] += v[c] * om;
             }
-        }
-        CubeMap::new(n, texels)
+            *w += om;
+        });
+        CubeMap::new(
+            n,
+            acc.iter().map(|(s, w)| s.map(|a| (a / w) as f32)).collect(),
+        )
     }
 
     /// Face size `n`.

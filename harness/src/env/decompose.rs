@@ -163,6 +163,18 @@ impl Default for Options {
     }
 }
 
+impl Options {
+    /// The defaults for the numbers of lights `ks`, without a progress bar (tests, benches
+    /// and report sections, which show their own).
+    pub fn quiet(ks: &[usize]) -> Options {
+        Options {
+            ks: ks.to_vec(),
+            progress: false,
+            ..Options::default()
+        }
+    }
+}
+
 /// The RSL fitted to a region.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Fit {
@@ -235,17 +247,29 @@ impl Decomposition {
         self.regions.iter().map(Region::rsl).collect()
     }
 
-    /// Relative L2 error of the luminance against its per-region average (module docs).
-    pub fn piecewise_rel_l2(&self, cube: &CubeMap) -> f64 {
+    /// `(Σ_k dev(w_k, L_k − E_r/|S_r|), Σ_k mag(w_k, L_k))` over the texels (luminance,
+    /// solid angle `w_k`, `r` the texel's region).
+    fn piecewise_sums(
+        &self,
+        cube: &CubeMap,
+        dev: impl Fn(f64, f64) -> f64,
+        mag: impl Fn(f64, f64) -> f64,
+    ) -> (f64, f64) {
         let (mut num, mut den) = (0.0, 0.0);
         for (k, &r) in self.region_of.iter().enumerate() {
             let reg = &self.regions[r as usize];
             let mean = reg.luminance_energy / reg.solid_angle;
             let l = cube.luminance(k);
             let w = cube.solid_angles()[k];
-            num += w * (l - mean) * (l - mean);
-            den += w * l * l;
+            num += dev(w, l - mean);
+            den += mag(w, l);
         }
+        (num, den)
+    }
+
+    /// Relative L2 error of the luminance against its per-region average (module docs).
+    pub fn piecewise_rel_l2(&self, cube: &CubeMap) -> f64 {
+        let (num, den) = self.piecewise_sums(cube, |w, d| w * d * d, |w, l| w * l * l);
         if den > 0.0 { (num / den).sqrt() } else { 0.0 }
     }
 
@@ -253,15 +277,7 @@ impl Decomposition {
     /// `Σ_k w_k |L_k − E_r/|S_r|| / Σ_k w_k L_k` (less dominated by the brightest texels
     /// than the L2 measures).
     pub fn piecewise_rel_l1(&self, cube: &CubeMap) -> f64 {
-        let (mut num, mut den) = (0.0, 0.0);
-        for (k, &r) in self.region_of.iter().enumerate() {
-            let reg = &self.regions[r as usize];
-            let mean = reg.luminance_energy / reg.solid_angle;
-            let l = cube.luminance(k);
-            let w = cube.solid_angles()[k];
-            num += w * (l - mean).abs();
-            den += w * l;
-        }
+        let (num, den) = self.piecewise_sums(cube, |w, d| w * d.abs(), |w, l| w * l);
         if den > 0.0 { num / den } else { 0.0 }
     }
 
@@ -291,6 +307,24 @@ pub fn basis(c: DVec3) -> (DVec3, DVec3) {
     let t = DVec3::new(1.0 + sign * c.x * c.x * a, sign * b, -sign * c.x);
     let bt = DVec3::new(b, sign + c.y * c.y * a, -c.y);
     (t, bt)
+}
+
+/// Lambert azimuthal equal-area coordinates `q = (x, y)·sqrt(2/(1 + z))` of the unit
+/// direction `d` in the frame `(t, b, c)` (module docs: area in `q` = solid angle).
+#[inline]
+fn lambert(d: DVec3, t: DVec3, bt: DVec3, c: DVec3) -> (f64, f64) {
+    let (x, y, z) = (d.dot(t), d.dot(bt), d.dot(c));
+    let s = (2.0 / (1.0 + z).max(1e-12_f64)).sqrt();
+    (x * s, y * s)
+}
+
+/// Chebyshev distance from the origin of `q` in the frame turned by `θ`, `(cs, sn) =
+/// (cos θ, sin θ)`: the half-side of the smallest square of rotation `θ` containing `q`.
+#[inline]
+fn chebyshev((qx, qy): (f64, f64), (cs, sn): (f64, f64)) -> f64 {
+    let xr = qx * cs + qy * sn;
+    let yr = -qx * sn + qy * cs;
+    xr.abs().max(yr.abs())
 }
 
 /// Per-texel data of the cube map, f64.
@@ -446,18 +480,13 @@ impl Fitter {
         ev.clear();
         for k in merged(a, b) {
             let k = k as usize;
-            let d = td.dir[k];
-            let (x, y, z) = (d.dot(t), d.dot(bt), d.dot(c));
-            let s = (2.0 / (1.0 + z).max(1e-12_f64)).sqrt();
-            let (qx, qy) = (x * s, y * s);
+            let q = lambert(td.dir[k], t, bt, c);
             let h = 0.5 * td.w[k].sqrt();
             let wl = td.lum[k] * td.w[k] / nr;
             let wc = td.w[k] / nr;
             let inv = 1.0 / (2.0 * SQRT_2 * h);
-            for &(cs, sn) in &rot {
-                let xr = qx * cs + qy * sn;
-                let yr = -qx * sn + qy * cs;
-                let dd = xr.abs().max(yr.abs());
+            for &cs_sn in &rot {
+                let dd = chebyshev(q, cs_sn);
                 ev.push((SQRT_2 * (dd - h), wl * inv, wc * inv));
                 ev.push((SQRT_2 * (dd + h), -wl * inv, -wc * inv));
             }
@@ -515,17 +544,11 @@ impl Fitter {
         let rho = (0.5 * fit.solid_angle).sqrt();
         let mut best = (f64::INFINITY, 0usize);
         for (i, r) in ROTATIONS.iter().enumerate() {
-            let (cs, sn) = (r.cos(), r.sin());
+            let cs_sn = (r.cos(), r.sin());
             let (mut g, mut cc) = (0.0, 0.0);
             for &k in texels {
                 let k = k as usize;
-                let d = td.dir[k];
-                let (x, y, z) = (d.dot(t), d.dot(bt), d.dot(c));
-                let s = (2.0 / (1.0 + z).max(1e-12_f64)).sqrt();
-                let (qx, qy) = (x * s, y * s);
-                let xr = qx * cs + qy * sn;
-                let yr = -qx * sn + qy * cs;
-                let dd = xr.abs().max(yr.abs());
+                let dd = chebyshev(lambert(td.dir[k], t, bt, c), cs_sn);
                 let h = 0.5 * td.w[k].sqrt();
                 let cov = ((rho / SQRT_2 - (dd - h)) / (2.0 * h)).clamp(0.0, 1.0);
                 g += cov * td.lum[k] * td.w[k];

@@ -12,7 +12,7 @@ use std::path::Path;
 use glam::DVec3;
 
 use super::EnvError;
-use super::cubemap::{CubeMap, FACES, rect_solid_angle};
+use super::cubemap::CubeMap;
 
 /// An equirectangular RGB radiance image.
 #[derive(Clone, Debug)]
@@ -135,39 +135,13 @@ impl Equirect {
     /// sub-texels no wider than half a source pixel (weights: exact sub-texel solid angles).
     /// Constants are reproduced exactly; the total integral matches
     /// [`Equirect::integral`] to the accuracy of the bilinear reconstruction (the test
-    /// `resampling_conserves_the_real_environments_energy` states the measured bound).
+    /// `loads_the_real_exr_and_a_hdr_written_from_it` states the measured bound).
     pub fn to_cubemap(&self, n: usize) -> Result<CubeMap, EnvError> {
         let n = n.max(1);
         // Cube texels are at most (π/2)/n wide (face centre); source pixels π/H tall.
         let src = PI / self.height as f64;
         let cube = 0.5 * PI / n as f64;
         let sub = ((2.0 * cube / src).ceil() as usize).clamp(1, 32);
-        let h = 2.0 / n as f64;
-        let hs = h / sub as f64;
-        let mut texels = Vec::with_capacity(6 * n * n);
-        for (face, (fn_, u, v)) in FACES.iter().enumerate() {
-            let _ = face;
-            for j in 0..n {
-                for i in 0..n {
-                    let mut acc = [0.0f64; 3];
-                    let mut wsum = 0.0;
-                    for sj in 0..sub {
-                        let b0 = -1.0 + h * j as f64 + hs * sj as f64;
-                        for si in 0..sub {
-                            let a0 = -1.0 + h * i as f64 + hs * si as f64;
-                            let om = rect_solid_angle(a0, a0 + hs, b0, b0 + hs);
-                            let d = *fn_ + *u * (a0 + 0.5 * hs) + *v * (b0 + 0.5 * hs);
-                            let val = self.sample_bilinear(d);
-                            for c in 0..3 {
-                                acc[c] += val[c] * om;
-                            }
-                            wsum += om;
-                        }
-                    }
-                    texels.push(acc.map(|a| (a / wsum) as f32));
-                }
-            }
-        }
-        CubeMap::new(n, texels)
+        CubeMap::from_fn(n, sub, |d| self.sample_bilinear(d))
     }
 }

@@ -5,8 +5,8 @@
 //!   6 × 32 × 32 by default as in the paper);
 //! - [`hdr`]: Radiance `.hdr` / OpenEXR equirectangular images and their resampling;
 //! - [`sky`]: the embedded default, a procedural sky with a sun and a known integral;
-//! - [`decompose`]: bottom-up merging (Figure 5) with the RSL fit of section 4.1.1 and the
-//!   area penalty of eq. 7, driven by a priority queue.
+//! - [`decompose`](mod@decompose): bottom-up merging (Figure 5) with the RSL fit of
+//!   section 4.1.1 and the area penalty of eq. 7, driven by a priority queue.
 
 pub mod cubemap;
 pub mod decompose;

@@ -41,12 +41,7 @@ fn run_env(
     let t = Instant::now();
     let cube = build()?;
     let build_s = t.elapsed().as_secs_f64();
-    let mut o = DecOptions {
-        ks: PAPER_KS.to_vec(),
-        cross_face: true,
-        progress: false,
-        objective: Objective::Bound,
-    };
+    let mut o = DecOptions::quiet(&PAPER_KS);
     let cross = decompose(&cube, &o)?;
     // The paper's setup: eq. 7 as the merge key, merges within a face only.
     o.cross_face = false;
@@ -181,15 +176,7 @@ pub fn section(_opts: &Options) -> Result<Section, Box<dyn Error>> {
     let small = env::default_sky(N_BASELINE)?;
     let kb = 10;
     let t = Instant::now();
-    let heap = decompose(
-        &small,
-        &DecOptions {
-            ks: vec![kb],
-            cross_face: true,
-            progress: false,
-            objective: Objective::Bound,
-        },
-    )?;
+    let heap = decompose(&small, &DecOptions::quiet(&[kb]))?;
     let heap_s = t.elapsed().as_secs_f64();
     let t = Instant::now();
     let rescan = decompose_rescan(&small, kb, true, Objective::Bound)?;

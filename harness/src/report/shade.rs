@@ -16,7 +16,7 @@ use steradian_core::shade::{self, ShadeLight, VdtQuery, VdtVisibility};
 use super::Options;
 use super::sections::Section;
 use crate::backend::gpu::{Custom, try_gpu};
-use crate::env::decompose::{Decomposition, Objective, Options as DecOptions, decompose};
+use crate::env::decompose::{Decomposition, Objective, Options as DecOptions, PAPER_KS, decompose};
 use crate::env::{self, CubeMap};
 use crate::kernels::Columns;
 use crate::shade::{self as sh, Samples, Scene, Settings, VARIANTS, Variant};
@@ -63,10 +63,8 @@ fn study(name: &str, cube: &CubeMap) -> Result<EnvResult, Box<dyn Error>> {
         let mut d = decompose(
             cube,
             &DecOptions {
-                ks: vec![10, 30, 60, 100],
-                cross_face: true,
-                progress: false,
                 objective,
+                ..DecOptions::quiet(&PAPER_KS)
             },
         )?;
         d.reverse();
@@ -122,15 +120,7 @@ type Throughput = (f64, f64, Result<f64, String>, usize, usize);
 /// Throughput in RSL evaluations per second: scalar, SIMD, wgpu (or why not).
 fn throughput(opts: &Options) -> Result<Throughput, Box<dyn Error>> {
     let cube = env::default_sky(32)?;
-    let decs = decompose(
-        &cube,
-        &DecOptions {
-            ks: vec![30],
-            cross_face: true,
-            progress: false,
-            objective: Objective::Bound,
-        },
-    )?;
+    let decs = decompose(&cube, &DecOptions::quiet(&[30]))?;
     let lights: Vec<ShadeLight> = decs[0].rsls()?.iter().map(ShadeLight::from).collect();
     let brdf = Lambert::new(0.8)?;
     let refs: Vec<&Decomposition> = decs.iter().collect();
