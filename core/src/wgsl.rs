@@ -211,6 +211,15 @@ pub const ALL: [(&str, &str); 5] = [
     ("cap-exponent", CAP_EXPONENT),
 ];
 
+/// The kernels outside [`ALL`], with a caller-supplied table at binding 3 (run them with
+/// the harness's custom kernels), as `(name, source, element type of the table)`.
+pub const CUSTOM: [(&str, &str, &str); 4] = [
+    ("lobe-product", LOBE_PRODUCT, "f32"),
+    ("sat-box", SAT_BOX, "u32"),
+    ("vdt-query", VDT_QUERY, "f32"),
+    ("shade", SHADE, "u32"),
+];
+
 /// Per-component absolute difference allowed between [`HEMISPHERE_MAP`] and
 /// `hemisphere::map` (the components lie in `[−1, 1]`). Lavapipe: `1.8e-7` (4 ULP), from
 /// the power-of-two scaling.

@@ -1,7 +1,8 @@
 //! Summed-area tables: `steradian_core::sat` against the f64 brute-force sum (property tests
 //! with a fixed seed, the stated bound `2⁻²⁴·|I| + 2⁻¹⁵⁰ + 2⁻⁴⁶·A + n·2⁻⁵⁹·T`), named hard cases,
 //! the SIMD kernel lane by lane (bit-exact), the WGSL kernel on a real adapter (within
-//! `wgsl::SAT_BOX_REL_TOL`), naga validation, and `steradian eval sat-box`.
+//! `wgsl::SAT_BOX_REL_TOL`; naga validation is in `wgsl_validate.rs`), and
+//! `steradian eval sat-box`.
 
 use proptest::prelude::*;
 use proptest::test_runner::{Config, RngSeed};
@@ -544,31 +545,6 @@ fn integer_boxes_of_integer_texels_are_correctly_rounded() {
 }
 
 // ---- WGSL --------------------------------------------------------------------------------
-
-#[test]
-fn sat_box_wgsl_validates() {
-    use naga::valid::{Capabilities, ValidationFlags, Validator};
-    let src = wgsl::SAT_BOX;
-    let module = naga::front::wgsl::parse_str(src)
-        .unwrap_or_else(|e| panic!("WGSL parse error:\n{}", e.emit_to_string(src)));
-    Validator::new(ValidationFlags::all(), Capabilities::all())
-        .validate(&module)
-        .unwrap_or_else(|e| panic!("WGSL validation error:\n{}", e.emit_to_string(src)));
-    let ep = module
-        .entry_points
-        .iter()
-        .find(|e| e.name == "main")
-        .expect("entry point main");
-    assert_eq!(ep.workgroup_size, [64, 1, 1]);
-    let bindings: Vec<u32> = module
-        .global_variables
-        .iter()
-        .filter_map(|(_, v)| v.binding.as_ref().map(|b| b.binding))
-        .collect();
-    for b in 0..4 {
-        assert!(bindings.contains(&b), "binding {b}");
-    }
-}
 
 /// The WGSL kernel against the scalar kernel lane by lane, on finite corners:
 /// `|gpu − cpu| ≤ SAT_BOX_REL_TOL·A` (A = Σ|t| over the texels the query reads).

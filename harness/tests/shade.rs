@@ -285,22 +285,6 @@ fn simd_matches_scalar_lane_by_lane() {
 }
 
 #[test]
-fn shade_wgsl_validates() {
-    let src = steradian_core::wgsl::SHADE;
-    let m = naga::front::wgsl::parse_str(src)
-        .unwrap_or_else(|e| panic!("shade: WGSL parse error:\n{}", e.emit_to_string(src)));
-    naga::valid::Validator::new(
-        naga::valid::ValidationFlags::all(),
-        naga::valid::Capabilities::all(),
-    )
-    .validate(&m)
-    .unwrap_or_else(|e| panic!("shade: WGSL validation error:\n{}", e.emit_to_string(src)));
-    assert_eq!(m.entry_points.len(), 1);
-    assert_eq!(m.entry_points[0].name, "main");
-    assert_eq!(m.entry_points[0].workgroup_size, [64, 1, 1]);
-}
-
-#[test]
 fn gpu_matches_scalar() {
     let Some(mut g) = gpu() else { return };
     for glossy in [false, true] {

@@ -1,5 +1,6 @@
-//! Every WGSL kernel parses and validates with naga (no device needed), has the entry point
-//! `main` with `@workgroup_size(64)`, and the bindings documented in `steradian_core::wgsl`.
+//! Every WGSL kernel (`wgsl::ALL` and `wgsl::CUSTOM`) parses and validates with naga (no
+//! device needed), has the entry point `main` with `@workgroup_size(64)`, and the bindings
+//! documented in `steradian_core::wgsl`.
 
 use naga::valid::{Capabilities, ValidationFlags, Validator};
 use naga::{AddressSpace, ShaderStage, StorageAccess};
@@ -16,7 +17,7 @@ fn module(name: &str, src: &str) -> naga::Module {
 }
 
 /// `(binding, name, space)` of the expected globals of a kernel.
-fn expected(name: &str) -> Vec<(u32, &'static str, AddressSpace)> {
+fn expected(with_table: bool) -> Vec<(u32, &'static str, AddressSpace)> {
     let mut v = vec![
         (
             0,
@@ -34,7 +35,7 @@ fn expected(name: &str) -> Vec<(u32, &'static str, AddressSpace)> {
         ),
         (2, "params", AddressSpace::Uniform),
     ];
-    if name == "cap-exponent" {
+    if with_table {
         v.push((
             3,
             "table",
@@ -46,6 +47,75 @@ fn expected(name: &str) -> Vec<(u32, &'static str, AddressSpace)> {
     v
 }
 
+/// Entry point `main` with 64 threads, and exactly the documented bindings in group 0; the
+/// table (binding 3), where there is one, of `table_elem` (`"f32"` or `"u32"`).
+fn check_interface(name: &str, src: &str, table_elem: Option<&str>) {
+    let m = module(name, src);
+
+    // One compute entry point `main`, 64 threads.
+    assert_eq!(m.entry_points.len(), 1, "{name}: entry points");
+    let ep = &m.entry_points[0];
+    assert_eq!(ep.name, "main", "{name}: entry point name");
+    assert_eq!(ep.stage, ShaderStage::Compute, "{name}: stage");
+    assert_eq!(ep.workgroup_size, [64, 1, 1], "{name}: workgroup size");
+
+    // Exactly the documented bindings, all in group 0.
+    let mut globals: Vec<_> = m
+        .global_variables
+        .iter()
+        .filter_map(|(_, g)| g.binding.as_ref().map(|b| (b.group, b.binding, g)))
+        .collect();
+    globals.sort_by_key(|(g, b, _)| (*g, *b));
+    let want = expected(table_elem.is_some());
+    assert_eq!(globals.len(), want.len(), "{name}: number of bindings");
+    for ((group, binding, g), (wb, wname, wspace)) in globals.iter().zip(want) {
+        assert_eq!((*group, *binding), (0, wb), "{name}: binding of {wname}");
+        assert_eq!(
+            g.name.as_deref(),
+            Some(wname),
+            "{name}: name at binding {wb}"
+        );
+        assert_eq!(g.space, wspace, "{name}: address space of {wname}");
+        let ty = &m.types[g.ty].inner;
+        if wname == "params" {
+            // struct Params { n, row_stride, _pad0, _pad1: u32 }: 16 bytes
+            match ty {
+                naga::TypeInner::Struct { members, span } => {
+                    let names: Vec<_> = members.iter().map(|m| m.name.as_deref()).collect();
+                    assert_eq!(
+                        names,
+                        [Some("n"), Some("row_stride"), Some("_pad0"), Some("_pad1")],
+                        "{name}: Params members"
+                    );
+                    for mem in members {
+                        assert_eq!(
+                            m.types[mem.ty].inner,
+                            naga::TypeInner::Scalar(naga::Scalar::U32),
+                            "{name}: Params member types"
+                        );
+                    }
+                    assert_eq!(*span, 16, "{name}: Params size");
+                }
+                other => panic!("{name}: params is {other:?}, not a struct"),
+            }
+        } else {
+            let elem = if wname == "table" && table_elem == Some("u32") {
+                naga::Scalar::U32
+            } else {
+                naga::Scalar::F32
+            };
+            match ty {
+                naga::TypeInner::Array { base, .. } => assert_eq!(
+                    m.types[*base].inner,
+                    naga::TypeInner::Scalar(elem),
+                    "{name}: element type of {wname}"
+                ),
+                other => panic!("{name}: {wname} is {other:?}, not an array"),
+            }
+        }
+    }
+}
+
 #[test]
 fn every_kernel_validates_with_the_documented_interface() {
     for (name, src) in wgsl::ALL {
@@ -53,65 +123,14 @@ fn every_kernel_validates_with_the_documented_interface() {
             Kernel::from_name(name).is_some(),
             "{name}: not a harness kernel name"
         );
-        let m = module(name, src);
+        check_interface(name, src, (name == "cap-exponent").then_some("f32"));
+    }
+}
 
-        // One compute entry point `main`, 64 threads.
-        assert_eq!(m.entry_points.len(), 1, "{name}: entry points");
-        let ep = &m.entry_points[0];
-        assert_eq!(ep.name, "main", "{name}: entry point name");
-        assert_eq!(ep.stage, ShaderStage::Compute, "{name}: stage");
-        assert_eq!(ep.workgroup_size, [64, 1, 1], "{name}: workgroup size");
-
-        // Exactly the documented bindings, all in group 0.
-        let mut globals: Vec<_> = m
-            .global_variables
-            .iter()
-            .filter_map(|(_, g)| g.binding.as_ref().map(|b| (b.group, b.binding, g)))
-            .collect();
-        globals.sort_by_key(|(g, b, _)| (*g, *b));
-        let want = expected(name);
-        assert_eq!(globals.len(), want.len(), "{name}: number of bindings");
-        for ((group, binding, g), (wb, wname, wspace)) in globals.iter().zip(want) {
-            assert_eq!((*group, *binding), (0, wb), "{name}: binding of {wname}");
-            assert_eq!(
-                g.name.as_deref(),
-                Some(wname),
-                "{name}: name at binding {wb}"
-            );
-            assert_eq!(g.space, wspace, "{name}: address space of {wname}");
-            let ty = &m.types[g.ty].inner;
-            if wname == "params" {
-                // struct Params { n, row_stride, _pad0, _pad1: u32 }: 16 bytes
-                match ty {
-                    naga::TypeInner::Struct { members, span } => {
-                        let names: Vec<_> = members.iter().map(|m| m.name.as_deref()).collect();
-                        assert_eq!(
-                            names,
-                            [Some("n"), Some("row_stride"), Some("_pad0"), Some("_pad1")],
-                            "{name}: Params members"
-                        );
-                        for mem in members {
-                            assert_eq!(
-                                m.types[mem.ty].inner,
-                                naga::TypeInner::Scalar(naga::Scalar::U32),
-                                "{name}: Params member types"
-                            );
-                        }
-                        assert_eq!(*span, 16, "{name}: Params size");
-                    }
-                    other => panic!("{name}: params is {other:?}, not a struct"),
-                }
-            } else {
-                match ty {
-                    naga::TypeInner::Array { base, .. } => assert_eq!(
-                        m.types[*base].inner,
-                        naga::TypeInner::Scalar(naga::Scalar::F32),
-                        "{name}: element type of {wname}"
-                    ),
-                    other => panic!("{name}: {wname} is {other:?}, not array<f32>"),
-                }
-            }
-        }
+#[test]
+fn every_custom_kernel_validates_with_the_documented_interface() {
+    for (name, src, table) in wgsl::CUSTOM {
+        check_interface(name, src, Some(table));
     }
 }
 
