@@ -209,8 +209,8 @@ pub fn chart(
                 s,
                 r#"<polyline points="{}" fill="none" stroke="{c}" stroke-width="{}"/>"#,
                 line.join(" "),
-                // Earlier series are drawn wider, so that series on top of them stay visible.
-                1.5 + 2.5 * (series.len() - 1 - i) as f64 / series.len().max(1) as f64
+                // The first series is drawn wide, so that series on top of it stay visible.
+                if i == 0 { 5.0 } else { 1.5 }
             );
         }
         for p in pts {
@@ -229,7 +229,7 @@ pub fn chart(
             let _ = writeln!(
                 s,
                 r#"<circle cx="{x:.1}" cy="{y:.1}" r="{}" fill="{c}">{tip}</circle>"#,
-                3.5 + 2.0 * (series.len() - 1 - i) as f64 / series.len().max(1) as f64
+                if i == 0 { 6.0 } else { 3.5 }
             );
         }
         let ly = top + 16.0 + 18.0 * i as f64;
