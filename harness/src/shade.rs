@@ -40,6 +40,7 @@ use steradian_core::shade::{
     self, Moments, ShadeLight, VdtQuery, VdtVisibility, multi_product_bound,
 };
 use steradian_core::vdt::Vdt;
+use steradian_core::vis_moments::VisMoments;
 use steradian_core::visibility::{Outside, binary_into, coverage_into, local_cap};
 use steradian_simd::shade::{IsoBrdfTables, ShadeInput, shade_batch};
 
@@ -177,6 +178,17 @@ fn push_point(points: &mut Vec<ShadePoint>, pos: DVec3, n: DVec3, eye: DVec3, oc
 /// The visibility map of a point on an `n × n` grid: coverage of the union of its
 /// occluders' caps ([`Outside::Visible`]), thresholded at ½, and its VDT.
 pub fn point_vdt(scene: &Scene, p: &ShadePoint, n: usize) -> Vdt {
+    Vdt::build(n, n, &point_mask(scene, p, n)).expect("valid map")
+}
+
+/// The visibility moment tables of a point ([`VisMoments`]) over the same `n × n` binary
+/// map as [`point_vdt`].
+pub fn point_moments(scene: &Scene, p: &ShadePoint, n: usize) -> VisMoments {
+    VisMoments::build(n, &point_mask(scene, p, n)).expect("valid map")
+}
+
+/// The binary visibility map of a point on an `n × n` grid (module docs of [`point_vdt`]).
+pub fn point_mask(scene: &Scene, p: &ShadePoint, n: usize) -> Vec<bool> {
     let caps: Vec<_> = p
         .occluders
         .iter()
@@ -195,7 +207,7 @@ pub fn point_vdt(scene: &Scene, p: &ShadePoint, n: usize) -> Vdt {
     coverage_into(&caps, n, Outside::Visible, &mut cov).expect("valid grid");
     let mut mask = vec![false; n * n];
     binary_into(&cov, &mut mask);
-    Vdt::build(n, n, &mask).expect("valid map")
+    mask
 }
 
 /// Sub-texel samples of a cube map: direction, exact solid angle, texel index.
@@ -348,10 +360,13 @@ pub enum Variant {
     Kernel,
     /// The kernel with the paper's eq. 9 VDT query.
     KernelEq9,
+    /// The visibility-moments kernel: BRDF SAT with its gradient × visibility fraction and
+    /// first moment ([`shade::shade_moments`]).
+    Moments,
 }
 
 /// Every variant, in the order of [`PointResult::values`].
-pub const VARIANTS: [Variant; 7] = [
+pub const VARIANTS: [Variant; 8] = [
     Variant::MultiProduct,
     Variant::SquareJoint,
     Variant::SquareExact,
@@ -359,6 +374,7 @@ pub const VARIANTS: [Variant; 7] = [
     Variant::ExactBrdfVdt,
     Variant::Kernel,
     Variant::KernelEq9,
+    Variant::Moments,
 ];
 
 /// Results of one point for one decomposition.
@@ -494,6 +510,7 @@ pub fn analyse(setup: &Setup<'_>, decs: &[&Decomposition], settings: Settings) -
         let vdt = setup.vdts[pi].view();
         let vis_g = VdtVisibility::new(vdt, VdtQuery::Gradient).expect("square VDT");
         let vis_9 = VdtVisibility::new(vdt, VdtQuery::Eq9).expect("square VDT");
+        let vis_m = point_moments(setup.scene, p, vdt.width());
         let mut out = Vec::with_capacity(decs.len());
         for (regions, lights) in regions.iter().zip(&lights) {
             let mut res = PointResult {
@@ -524,7 +541,7 @@ pub fn analyse(setup: &Setup<'_>, decs: &[&Decomposition], settings: Settings) -
                 let sat = f64::from(setup.sat.integral(wo, pc, r) * l.inv_solid_angle());
                 let vg = f64::from(shade::SquareVisibility::fraction(&vis_g, pc, r));
                 let v9 = f64::from(shade::SquareVisibility::fraction(&vis_9, pc, r));
-                let mut f = [0.0f64; 7];
+                let mut f = [0.0f64; VARIANTS.len()];
                 if settings.exact_squares {
                     let (er, ev, ej) =
                         exact_square(setup.scene, p, setup.brdf, wo, pc, r, settings.square_cells);
@@ -535,6 +552,9 @@ pub fn analyse(setup: &Setup<'_>, decs: &[&Decomposition], settings: Settings) -
                 }
                 f[5] = sat * vg;
                 f[6] = sat * v9;
+                f[7] = f64::from(shade::light_factor_moments(
+                    &p.frame, wo, setup.sat, &vis_m, l,
+                ));
                 for v in 1..VARIANTS.len() {
                     for c in 0..3 {
                         res.values[v][c] += e[c] * f[v];

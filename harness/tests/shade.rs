@@ -95,47 +95,80 @@ fn k_index(e: &Env, k: usize) -> usize {
     e.decs.iter().position(|d| d.k == k).expect("K decomposed")
 }
 
-fn check_k30(e: &Env) {
-    let err = e.analysis.error(k_index(e, 30), Variant::Kernel);
+/// The K = 30 target for one kernel (`Variant::Kernel`, the paper's eq. 5, or
+/// `Variant::Moments`, the visibility-moments kernel).
+fn check_k30(e: &Env, variant: Variant) {
+    let err = e.analysis.error(k_index(e, 30), variant);
     say(&format!(
-        "{}: K = 30 kernel relative L2 error {:.3} %",
+        "{}: K = 30 {variant:?} relative L2 error {:.3} %",
         e.name,
         100.0 * err
     ));
     assert!(
         err <= TARGET,
-        "{}: K = 30 error {:.3} % > 0.35 %",
+        "{}: K = 30 {variant:?} error {:.3} % > 0.35 %",
         e.name,
         100.0 * err
     );
 }
 
 #[test]
-#[ignore = "fails: measured 0.73 % (default sky; 1.06 % with the paper's merge) — the kernel's floor at K = 100 is 0.43 %: see the report's shading section"]
+#[ignore = "fails: measured 0.56 % with the moments kernel (0.73 % with eq. 5); the exact integral over the K = 30 uniform squares is already 0.51 % (SquareJoint): see the report's shading section"]
 fn k30_default_sky_within_0_35_percent() {
-    check_k30(sky());
+    check_k30(sky(), Variant::Moments);
 }
 
 #[test]
-#[ignore = "fails: measured 0.59 % (sky.exr; 0.60 % with the paper's merge) — see the report's shading section"]
 fn k30_real_hdr_within_0_35_percent() {
-    check_k30(real());
+    check_k30(real(), Variant::Moments);
+}
+
+#[test]
+#[ignore = "fails: measured 0.59 % (sky.exr; 0.60 % with the paper's merge): eq. 5 drops the BRDF-visibility covariance of the large sky squares; the moments kernel keeps it (0.30 %)"]
+fn k30_real_hdr_within_0_35_percent_eq5_kernel() {
+    check_k30(real(), Variant::Kernel);
+}
+
+/// The moments kernel keeps the covariance that eq. 5 drops: at K = 30 it is at least 20 %
+/// more accurate than the eq. 5 kernel on both environments, and within 0.1 percentage
+/// points of the exact integral over the same squares (`SquareJoint`, its floor).
+#[test]
+fn moments_kernel_beats_eq5_and_nears_the_square_floor() {
+    for e in [sky(), real()] {
+        let d = k_index(e, 30);
+        let (m, k, floor) = (
+            e.analysis.error(d, Variant::Moments),
+            e.analysis.error(d, Variant::Kernel),
+            e.analysis.error(d, Variant::SquareJoint),
+        );
+        say(&format!(
+            "{}: K = 30 moments {:.3} %, eq. 5 {:.3} %, square floor {:.3} %",
+            e.name,
+            100.0 * m,
+            100.0 * k,
+            100.0 * floor
+        ));
+        assert!(m <= 0.8 * k, "{}: {m} vs {k}", e.name);
+        assert!(m <= floor + 0.001, "{}: {m} vs floor {floor}", e.name);
+    }
 }
 
 fn check_decreasing(e: &Env) {
-    let errs: Vec<f64> = (0..e.decs.len())
-        .map(|d| e.analysis.error(d, Variant::Kernel))
-        .collect();
-    say(&format!("{}: kernel error per K {:?}", e.name, errs));
-    for w in errs.windows(2) {
-        assert!(
-            w[1] < w[0],
-            "{}: error does not decrease with K: {errs:?}",
-            e.name
-        );
+    for variant in [Variant::Kernel, Variant::Moments] {
+        let errs: Vec<f64> = (0..e.decs.len())
+            .map(|d| e.analysis.error(d, variant))
+            .collect();
+        say(&format!("{}: {variant:?} error per K {:?}", e.name, errs));
+        for w in errs.windows(2) {
+            assert!(
+                w[1] < w[0],
+                "{}: {variant:?} error does not decrease with K: {errs:?}",
+                e.name
+            );
+        }
+        // K = 100 beats K = 10 by a margin: the decomposition, not noise, drives it.
+        assert!(errs[3] < 0.5 * errs[0], "{variant:?} {errs:?}");
     }
-    // Every K beats K = 10 by a margin: the decomposition, not noise, drives it.
-    assert!(errs[3] < 0.5 * errs[0], "{errs:?}");
 }
 
 #[test]

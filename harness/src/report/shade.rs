@@ -115,7 +115,8 @@ fn time(min: Duration, mut f: impl FnMut()) -> f64 {
 }
 
 /// Scalar and SIMD RSL evaluations/s, wgpu's (or why not), points, lights.
-type Throughput = (f64, f64, Result<f64, String>, usize, usize);
+/// Scalar, SIMD, wgpu, scalar moments kernel (RSL evaluations/s), points, lights.
+type Throughput = (f64, f64, Result<f64, String>, f64, usize, usize);
 
 /// Throughput in RSL evaluations per second: scalar, SIMD, wgpu (or why not).
 fn throughput(opts: &Options) -> Result<Throughput, Box<dyn Error>> {
@@ -133,6 +134,18 @@ fn throughput(opts: &Options) -> Result<Throughput, Box<dyn Error>> {
             if let Ok(vis) = VdtVisibility::new(v.view(), VdtQuery::Gradient) {
                 black_box(shade::shade(&p.frame, p.wo, &sat, &vis, black_box(&lights)));
             }
+        }
+    });
+    let moments: Vec<_> = sh::par_map(&scene.points, |p| sh::point_moments(&scene, p, 64));
+    let t_moments = time(Duration::from_millis(400), || {
+        for (p, m) in scene.points.iter().zip(&moments) {
+            black_box(shade::shade_moments(
+                &p.frame,
+                p.wo,
+                &sat,
+                m,
+                black_box(&lights),
+            ));
         }
     });
     let t_simd = time(Duration::from_millis(400), || {
@@ -185,6 +198,7 @@ fn throughput(opts: &Options) -> Result<Throughput, Box<dyn Error>> {
         evals / t_scalar,
         evals / t_simd,
         gpu,
+        evals / t_moments,
         scene.points.len(),
         lights.len(),
     ))
@@ -206,7 +220,7 @@ pub fn section(opts: &Options) -> Result<Section, Box<dyn Error>> {
     )?;
     bar.inc(1);
     bar.set_message("throughput");
-    let (scalar, simd, gpu, np, nk) = throughput(opts)?;
+    let (scalar, simd, gpu, moments, np, nk) = throughput(opts)?;
     bar.inc(1);
     bar.finish_and_clear();
 
@@ -234,7 +248,7 @@ pub fn section(opts: &Options) -> Result<Section, Box<dyn Error>> {
             "<h3>{}</h3><table><tr><th>merge</th><th>K</th><th>kernel</th><th>kernel, eq. 9 VDT</th>\
              <th>eq. 13 bound</th><th>multi-product (true regions)</th><th>square, light only</th>\
              <th>square, exact ρ̄ and V̄</th><th>SAT ρ̄, exact V̄</th><th>exact ρ̄, VDT V̄</th>\
-             <th>paper Fig. 9 / 10</th></tr>",
+             <th>moments kernel</th><th>paper Fig. 9 / 10</th></tr>",
             e.name
         );
         for row in &e.rows {
@@ -244,7 +258,7 @@ pub fn section(opts: &Options) -> Result<Section, Box<dyn Error>> {
                 html,
                 "<tr><td>{obj:?}</td><td>{k}</td><td><b>{:.3} %</b></td><td>{:.3} %</td><td>{:.3} %</td>\
                  <td>{:.3} %</td><td>{:.3} %</td><td>{:.3} %</td><td>{:.3} %</td><td>{:.3} %</td>\
-                 <td>{}</td></tr>",
+                 <td><b>{:.3} %</b></td><td>{}</td></tr>",
                 100.0 * er[vi(Variant::Kernel)],
                 100.0 * er[vi(Variant::KernelEq9)],
                 100.0 * row.bound,
@@ -253,15 +267,18 @@ pub fn section(opts: &Options) -> Result<Section, Box<dyn Error>> {
                 100.0 * er[vi(Variant::SquareExact)],
                 100.0 * er[vi(Variant::SatExactV)],
                 100.0 * er[vi(Variant::ExactBrdfVdt)],
+                100.0 * er[vi(Variant::Moments)],
                 p.map_or(String::new(), |p| format!("{:.2} % / {:.2} %", p.1, p.2)),
             );
             let _ = writeln!(
                 summary,
-                "shade {:<22} {:<5} K = {k:3}: error {:.3} % (eq. 9 VDT {:.3} %), eq. 13 bound {:.3} % (multi-product {:.3} %)",
+                "shade {:<22} {:<5} K = {k:3}: error {:.3} % (eq. 9 VDT {:.3} %, moments kernel {:.3} %, exact over the squares {:.3} %), eq. 13 bound {:.3} % (multi-product {:.3} %)",
                 e.name,
                 format!("{obj:?}"),
                 100.0 * er[vi(Variant::Kernel)],
                 100.0 * er[vi(Variant::KernelEq9)],
+                100.0 * er[vi(Variant::Moments)],
+                100.0 * er[vi(Variant::SquareJoint)],
                 100.0 * row.bound,
                 100.0 * er[vi(Variant::MultiProduct)],
             );
@@ -280,7 +297,8 @@ pub fn section(opts: &Options) -> Result<Section, Box<dyn Error>> {
          <th>vs paper (19.4 M/s, 2005 GPU)</th></tr>\
          <tr><td>scalar</td><td>{:.1} M/s</td><td>1</td><td>{:.2}</td></tr>\
          <tr><td>SIMD (8 points per call)</td><td>{:.1} M/s</td><td>{:.2}</td><td>{:.2}</td></tr>\
-         <tr><td>wgpu</td><td>{gpu_s}</td><td>{}</td><td>{}</td></tr></table>",
+         <tr><td>wgpu</td><td>{gpu_s}</td><td>{}</td><td>{}</td></tr>\
+         <tr><td>moments kernel, scalar (64² moment tables)</td><td>{:.1} M/s</td><td>{:.2}</td><td>{:.2}</td></tr></table>",
         scalar / 1e6,
         scalar / PAPER_EVALS_PER_S,
         simd / 1e6,
@@ -290,13 +308,18 @@ pub fn section(opts: &Options) -> Result<Section, Box<dyn Error>> {
             .map_or("—".into(), |g| format!("{:.2}", g / scalar)),
         gpu.as_ref()
             .map_or("—".into(), |g| format!("{:.2}", g / PAPER_EVALS_PER_S)),
+        moments / 1e6,
+        moments / scalar,
+        moments / PAPER_EVALS_PER_S,
     );
     let _ = writeln!(
         summary,
-        "shade throughput (RSL evals/s): scalar {:.1} M, SIMD {:.1} M ({:.2}× scalar), wgpu {gpu_s}; paper 19.4 M",
+        "shade throughput (RSL evals/s): scalar {:.1} M, SIMD {:.1} M ({:.2}× scalar), wgpu {gpu_s}, moments kernel scalar {:.1} M ({:.2}× scalar); paper 19.4 M",
         scalar / 1e6,
         simd / 1e6,
-        simd / scalar
+        simd / scalar,
+        moments / 1e6,
+        moments / scalar
     );
     let env_json = |e: &EnvResult| {
         json!({
@@ -321,7 +344,7 @@ pub fn section(opts: &Options) -> Result<Section, Box<dyn Error>> {
             "environments": [env_json(&sky), env_json(&real)],
             "paper": PAPER.iter().map(|p| json!({"k": p.0, "fig9": p.1, "fig10": p.2})).collect::<Vec<_>>(),
             "throughput": {
-                "scalar": scalar, "simd": simd,
+                "scalar": scalar, "simd": simd, "moments_scalar": moments,
                 "gpu": gpu.as_ref().ok(),
                 "paper": PAPER_EVALS_PER_S,
                 "points": np, "k": nk,
