@@ -198,6 +198,21 @@ impl FitOptions {
     }
 }
 
+/// A view and a square's centre located among the tables ([`BrdfSat::locate`]).
+struct Located {
+    /// Lower polar view node and the fraction towards the next.
+    k0: usize,
+    t: f32,
+    /// Texels per disk unit (half the grid side).
+    half_n: f32,
+    /// The square's centre in texel units, in the table frame.
+    tc: Vec2,
+    /// `(cos φ, sin φ)` by which an isotropic table's frame is turned (`(1, 0)` otherwise).
+    turn: (f32, f32),
+    /// Anisotropic tables: the azimuth nodes and the fraction between them.
+    azimuth: Option<(usize, usize, f32)>,
+}
+
 /// Summed-area tables of a BRDF over the parametrisation square, one per view node.
 #[derive(Clone, Debug, PartialEq)]
 pub struct BrdfSat {
@@ -629,6 +644,55 @@ impl BrdfSat {
         (node_max, all_max, rms, count, worst)
     }
 
+    /// Where a view and a square's centre fall among the tables (shared by
+    /// [`BrdfSat::integral`] and [`BrdfSat::integral_gradient`]; the view must be finite
+    /// and above the horizon).
+    #[inline(always)]
+    fn locate(&self, wo_local: Vec3, centre: Vec2) -> Located {
+        let p = hemisphere::map(wo_local);
+        let s = math::sqrtf(p.x * p.x + p.y * p.y);
+        let m = self.res.polar;
+        let x = (s / self.s_max * (m - 1) as f32).clamp(0.0, (m - 1) as f32);
+        let k0 = (x as usize).min(m - 2);
+        let t = x - k0 as f32;
+        let half_n = 0.5 * self.res.grid as f32;
+        let a = self.res.azimuth;
+        if a == 1 {
+            let (c, sn) = if s > 0.0 {
+                (p.x / s, p.y / s)
+            } else {
+                (1.0, 0.0)
+            };
+            let q = Vec2::new(centre.x * c + centre.y * sn, centre.y * c - centre.x * sn);
+            let tc = (q + Vec2::ONE) * half_n;
+            Located {
+                k0,
+                t,
+                half_n,
+                tc,
+                turn: (c, sn),
+                azimuth: None,
+            }
+        } else {
+            let tc = (centre + Vec2::ONE) * half_n;
+            let phi = math::atan2f(p.y, p.x);
+            let y = phi / TWO_PI * a as f32;
+            let y = y - math::floorf(y / a as f32) * a as f32; // [0, a]
+            let l0f = math::floorf(y);
+            let u = y - l0f;
+            let l0 = (l0f as usize) % a;
+            let l1 = (l0 + 1) % a;
+            Located {
+                k0,
+                t,
+                half_n,
+                tc,
+                turn: (1.0, 0.0),
+                azimuth: Some((l0, l1, u)),
+            }
+        }
+    }
+
     /// `∫ ρ(wᵢ, wₒ)·cos θᵢ dωᵢ` over the square of the parametrisation plane with centre
     /// `centre` (disk units, the point [`hemisphere::map`] gives) and half-diagonal
     /// `half_diagonal`, for the local view direction `wo_local` (unit, `z` = normal).
@@ -643,39 +707,22 @@ impl BrdfSat {
         if wo_local.z <= 0.0 {
             return 0.0;
         }
-        let p = hemisphere::map(wo_local);
-        let s = math::sqrtf(p.x * p.x + p.y * p.y);
-        let m = self.res.polar;
-        let x = (s / self.s_max * (m - 1) as f32).clamp(0.0, (m - 1) as f32);
-        let k0 = (x as usize).min(m - 2);
-        let t = x - k0 as f32;
-        let half_n = 0.5 * self.res.grid as f32;
-        let r = half_diagonal * half_n;
-        let a = self.res.azimuth;
-        if a == 1 {
-            let (c, sn) = if s > 0.0 {
-                (p.x / s, p.y / s)
-            } else {
-                (1.0, 0.0)
-            };
-            let q = Vec2::new(centre.x * c + centre.y * sn, centre.y * c - centre.x * sn);
-            let tc = (q + Vec2::ONE) * half_n;
-            let v0 = self.sats[k0].square(tc, r);
-            let v1 = self.sats[k0 + 1].square(tc, r);
-            v0 + t * (v1 - v0)
-        } else {
-            let tc = (centre + Vec2::ONE) * half_n;
-            let phi = math::atan2f(p.y, p.x);
-            let y = phi / TWO_PI * a as f32;
-            let y = y - math::floorf(y / a as f32) * a as f32; // [0, a]
-            let l0f = math::floorf(y);
-            let u = y - l0f;
-            let l0 = (l0f as usize) % a;
-            let l1 = (l0 + 1) % a;
-            let at = |k: usize, l: usize| self.sats[k * a + l].square(tc, r);
-            let lo = at(k0, l0) + u * (at(k0, l1) - at(k0, l0));
-            let hi = at(k0 + 1, l0) + u * (at(k0 + 1, l1) - at(k0 + 1, l0));
-            lo + t * (hi - lo)
+        let n = self.locate(wo_local, centre);
+        let (k0, t, tc) = (n.k0, n.t, n.tc);
+        let r = half_diagonal * n.half_n;
+        match n.azimuth {
+            None => {
+                let v0 = self.sats[k0].square(tc, r);
+                let v1 = self.sats[k0 + 1].square(tc, r);
+                v0 + t * (v1 - v0)
+            }
+            Some((l0, l1, u)) => {
+                let a = self.res.azimuth;
+                let at = |k: usize, l: usize| self.sats[k * a + l].square(tc, r);
+                let lo = at(k0, l0) + u * (at(k0, l1) - at(k0, l0));
+                let hi = at(k0 + 1, l0) + u * (at(k0 + 1, l1) - at(k0 + 1, l0));
+                lo + t * (hi - lo)
+            }
         }
     }
 
@@ -698,16 +745,11 @@ impl BrdfSat {
         if wo_local.z <= 0.0 {
             return (0.0, Vec2::ZERO);
         }
-        let p = hemisphere::map(wo_local);
-        let s = math::sqrtf(p.x * p.x + p.y * p.y);
-        let m = self.res.polar;
-        let x = (s / self.s_max * (m - 1) as f32).clamp(0.0, (m - 1) as f32);
-        let k0 = (x as usize).min(m - 2);
-        let t = f64::from(x - k0 as f32);
-        let half_n = 0.5 * self.res.grid as f32;
-        let h = crate::sat::square_half_side(half_diagonal) * half_n;
+        let n = self.locate(wo_local, centre);
+        let (k0, t, tc) = (n.k0, f64::from(n.t), n.tc);
+        let h = crate::sat::square_half_side(half_diagonal) * n.half_n;
         // [whole, right − left, top − bottom] of one table around `tc` (texel units).
-        let parts = |k: usize, tc: Vec2| -> [f64; 3] {
+        let parts = |k: usize| -> [f64; 3] {
             let v = self.sats[k].view();
             let b = |u0: f32, v0: f32, u1: f32, v1: f32| v.box_sum_f64(u0, v0, u1, v1);
             let whole = b(tc.x - h, tc.y - h, tc.x + h, tc.y + h);
@@ -718,38 +760,24 @@ impl BrdfSat {
         let lerp = |a: [f64; 3], b: [f64; 3], u: f64| -> [f64; 3] {
             core::array::from_fn(|i| a[i] + u * (b[i] - a[i]))
         };
-        let a = self.res.azimuth;
-        let (sums, (c, sn)) = if a == 1 {
-            let (c, sn) = if s > 0.0 {
-                (p.x / s, p.y / s)
-            } else {
-                (1.0, 0.0)
-            };
-            let q = Vec2::new(centre.x * c + centre.y * sn, centre.y * c - centre.x * sn);
-            let tc = (q + Vec2::ONE) * half_n;
-            (lerp(parts(k0, tc), parts(k0 + 1, tc), t), (c, sn))
-        } else {
-            let tc = (centre + Vec2::ONE) * half_n;
-            let phi = math::atan2f(p.y, p.x);
-            let y = phi / TWO_PI * a as f32;
-            let y = y - math::floorf(y / a as f32) * a as f32;
-            let l0f = math::floorf(y);
-            let u = f64::from(y - l0f);
-            let l0 = (l0f as usize) % a;
-            let l1 = (l0 + 1) % a;
-            let at = |k: usize, l: usize| parts(k * a + l, tc);
-            let lo = lerp(at(k0, l0), at(k0, l1), u);
-            let hi = lerp(at(k0 + 1, l0), at(k0 + 1, l1), u);
-            (lerp(lo, hi, t), (1.0, 0.0))
+        let sums = match n.azimuth {
+            None => lerp(parts(k0), parts(k0 + 1), t),
+            Some((l0, l1, u)) => {
+                let (a, u) = (self.res.azimuth, f64::from(u));
+                let at = |k: usize, l: usize| parts(k * a + l);
+                let lo = lerp(at(k0, l0), at(k0, l1), u);
+                let hi = lerp(at(k0 + 1, l0), at(k0 + 1, l1), u);
+                lerp(lo, hi, t)
+            }
         };
-        let hd = f64::from(h) / f64::from(half_n);
+        let hd = f64::from(h) / f64::from(n.half_n);
         if hd <= 0.0 {
             return (sums[0] as f32, Vec2::ZERO);
         }
         let k = 1.0 / (2.0 * hd * hd * hd);
         // Gradient in the (possibly azimuth-turned) table frame, turned back.
         let (gx, gy) = (sums[1] * k, sums[2] * k);
-        let (c, sn) = (f64::from(c), f64::from(sn));
+        let (c, sn) = (f64::from(n.turn.0), f64::from(n.turn.1));
         let g = Vec2::new((c * gx - sn * gy) as f32, (sn * gx + c * gy) as f32);
         (sums[0] as f32, g)
     }

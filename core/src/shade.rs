@@ -307,13 +307,27 @@ where
     B: BrdfIntegral + ?Sized,
     V: SquareVisibility + ?Sized,
 {
+    sum_lights(frame, wo, lights, |wo_local, l| {
+        light_factor(frame, wo_local, brdf, vis, l)
+    })
+}
+
+/// `Σᵢ Eᵢ·factor(wₒ local, light i)` in light order, RGB; 0 for a view on or below the
+/// horizon (the loop of [`shade`] and [`shade_moments`]).
+#[inline(always)]
+fn sum_lights(
+    frame: &Frame,
+    wo: Vec3,
+    lights: &[ShadeLight],
+    factor: impl Fn(Vec3, &ShadeLight) -> f32,
+) -> [f32; 3] {
     let wo_local = frame.to_local(wo);
     if wo_local.z <= 0.0 {
         return [0.0; 3];
     }
     let mut acc = [0.0f32; 3];
     for l in lights {
-        let f = light_factor(frame, wo_local, brdf, vis, l);
+        let f = factor(wo_local, l);
         acc[0] += l.energy[0] * f;
         acc[1] += l.energy[1] * f;
         acc[2] += l.energy[2] * f;
@@ -372,18 +386,9 @@ where
     B: BrdfIntegral + ?Sized,
     V: SquareMoments + ?Sized,
 {
-    let wo_local = frame.to_local(wo);
-    if wo_local.z <= 0.0 {
-        return [0.0; 3];
-    }
-    let mut acc = [0.0f32; 3];
-    for l in lights {
-        let f = light_factor_moments(frame, wo_local, brdf, vis, l);
-        acc[0] += l.energy[0] * f;
-        acc[1] += l.energy[1] * f;
-        acc[2] += l.energy[2] * f;
-    }
-    acc
+    sum_lights(frame, wo, lights, |wo_local, l| {
+        light_factor_moments(frame, wo_local, brdf, vis, l)
+    })
 }
 
 /// Mean, standard deviation and third absolute central moment of a function over a region
