@@ -264,6 +264,13 @@ impl ShadeLight {
     pub fn energy(&self) -> [f32; 3] {
         self.energy
     }
+    /// The centre and half-diagonal of [`ShadeLight::project`]'s square, `None` when it is
+    /// wholly below the horizon (the cull every shading kernel applies first).
+    #[inline]
+    pub fn square_above_horizon(&self, frame: &Frame) -> Option<(Vec2, f32)> {
+        let sq = self.project(frame);
+        (!sq.is_below_horizon()).then_some((sq.centre, sq.half_diagonal))
+    }
     /// The light's square in the parametrisation of `frame` ([`Rsl::project`] without the
     /// square root of `Ω`).
     #[inline]
@@ -289,11 +296,9 @@ where
     B: BrdfIntegral + ?Sized,
     V: SquareVisibility + ?Sized,
 {
-    let sq = light.project(frame);
-    if sq.is_below_horizon() {
+    let Some((p, r)) = light.square_above_horizon(frame) else {
         return 0.0;
-    }
-    let (p, r) = (sq.centre, sq.half_diagonal);
+    };
     let rho = brdf.integral(wo_local, p, r) * light.inv_solid_angle;
     rho * vis.fraction(p, r)
 }
@@ -350,11 +355,9 @@ where
     B: BrdfIntegral + ?Sized,
     V: SquareMoments + ?Sized,
 {
-    let sq = light.project(frame);
-    if sq.is_below_horizon() {
+    let Some((p, r)) = light.square_above_horizon(frame) else {
         return 0.0;
-    }
-    let (p, r) = (sq.centre, sq.half_diagonal);
+    };
     let (i, g) = brdf.integral_gradient(wo_local, p, r);
     let (f, m) = vis.moments(p, r);
     // |R| in disk units: the square of half-diagonal r has side r·√2.
@@ -485,6 +488,63 @@ mod tests {
         );
         assert!(nan.iter().all(|c| c.is_nan()));
         assert_eq!(shade(&f, Vec3::Z, &Flat(0.3), &Unoccluded, &[]), [0.0; 3]);
+    }
+
+    /// A BRDF density linear over every square: `φ(x) = a + g·x` per unit disk area.
+    struct Linear {
+        a: f32,
+        g: Vec2,
+    }
+    impl BrdfIntegral for Linear {
+        fn integral(&self, _wo: Vec3, c: Vec2, r: f32) -> f32 {
+            (self.a + self.g.dot(c)) * 2.0 * r * r
+        }
+        fn integral_gradient(&self, wo: Vec3, c: Vec2, r: f32) -> (f32, Vec2) {
+            (self.integral(wo, c, r), self.g)
+        }
+    }
+    /// Visible where `x > c.x` (the right half of every square): `f = ½`, `m = (h/4, 0)`.
+    struct RightHalf;
+    impl SquareMoments for RightHalf {
+        fn moments(&self, _c: Vec2, r: f32) -> (f32, Vec2) {
+            (
+                0.5,
+                Vec2::new(0.25 * r * core::f32::consts::FRAC_1_SQRT_2, 0.0),
+            )
+        }
+    }
+
+    /// `I·f + |R|·g·m` is exact for a linear density: over the right half of a square of
+    /// half-side `h`, `∫φ = φ(c)·2h² + g_x·h³`; eq. 5's product of means misses `g_x·h³`.
+    #[test]
+    fn moments_factor_is_exact_for_a_linear_density() {
+        let f = Frame::from_normal(Vec3::Z).unwrap();
+        let l = Rsl::new(Vec3::new(0.3, -0.2, 1.0), Vec3::X, 0.4, [1.0; 3]).unwrap();
+        let light = ShadeLight::from(&l);
+        let (c, r) = light.square_above_horizon(&f).unwrap();
+        let h = r * core::f32::consts::FRAC_1_SQRT_2;
+        let b = Linear {
+            a: 0.5,
+            g: Vec2::new(-0.4, 0.2),
+        };
+        let exact = ((b.a + b.g.dot(c)) * 2.0 * h * h + b.g.x * h * h * h) * light.inv_solid_angle;
+        let got = light_factor_moments(&f, Vec3::Z, &b, &RightHalf, &light);
+        assert!((got - exact).abs() <= 1e-6 * exact, "{got} vs {exact}");
+        // clamped to [0, I]: a gradient steep enough to make the linear model negative
+        let steep = Linear {
+            a: 0.01,
+            g: Vec2::new(-50.0, 0.0),
+        };
+        assert_eq!(
+            light_factor_moments(&f, Vec3::Z, &steep, &RightHalf, &light),
+            0.0
+        );
+        // below the horizon: 0
+        let down = ShadeLight::from(&Rsl::new(-Vec3::Z, Vec3::X, 0.05, [1.0; 3]).unwrap());
+        assert_eq!(
+            light_factor_moments(&f, Vec3::Z, &b, &RightHalf, &down),
+            0.0
+        );
     }
 
     #[test]

@@ -67,13 +67,14 @@ impl VisMoments {
         let mut v = Vec::with_capacity(len);
         let mut xv = Vec::with_capacity(len);
         let mut yv = Vec::with_capacity(len);
-        for (k, &m) in mask.iter().enumerate() {
-            let (i, j) = (k % n.max(1), k / n.max(1));
-            let w = if m { 1.0f32 } else { 0.0 };
-            v.push(w);
-            // Exact in f32: n ≤ 2^24 and the offsets are multiples of ½.
-            xv.push(w * (i as f32 + 0.5 - half));
-            yv.push(w * (j as f32 + 0.5 - half));
+        for (j, row) in mask.chunks(n.max(1)).enumerate() {
+            for (i, &m) in row.iter().enumerate() {
+                let w = if m { 1.0f32 } else { 0.0 };
+                v.push(w);
+                // Exact in f32: n ≤ 2^24 and the offsets are multiples of ½.
+                xv.push(w * (i as f32 + 0.5 - half));
+                yv.push(w * (j as f32 + 0.5 - half));
+            }
         }
         Ok(VisMoments {
             n,

@@ -532,11 +532,9 @@ pub fn analyse(setup: &Setup<'_>, decs: &[&Decomposition], settings: Settings) -
             }
             // Squares.
             for l in lights {
-                let sq = l.project(&p.frame);
-                if sq.is_below_horizon() {
+                let Some((pc, r)) = l.square_above_horizon(&p.frame) else {
                     continue;
-                }
-                let (pc, r) = (sq.centre, sq.half_diagonal);
+                };
                 let e = l.energy().map(f64::from);
                 let sat = f64::from(setup.sat.integral(wo, pc, r) * l.inv_solid_angle());
                 let vg = f64::from(shade::SquareVisibility::fraction(&vis_g, pc, r));
