@@ -71,6 +71,31 @@ pub fn unmap(p: Vec2) -> Vec3 {
     Vec3::new(px * s, py * s, 1.0 - r2)
 }
 
+/// The partial derivatives `(∂ω/∂u, ∂ω/∂v)` of the inverse map `ω(p) = (p·sqrt(2 − |p|²),
+/// 1 − |p|²)` at `p`: with `s = sqrt(2 − |p|²)`,
+///
+/// ```text
+///   ∂ω/∂u = (s − u²/s, −u·v/s, −2u),   ∂ω/∂v = (−u·v/s, s − v²/s, −2v),
+/// ```
+///
+/// and `|∂ω/∂u × ∂ω/∂v| = 2` (the map is equal-area). The formula is that of the whole-sphere
+/// map ([`crate::rsl::map_extended`]), so it holds beyond the unit disk up to `|p| = √2`
+/// (the antipode), where `s → 0`; `|p|²` is clamped to `2 − 2⁻¹²` there so the result
+/// stays finite (near the antipode a first-order model of the map is meaningless anyway).
+/// Used by the moments kernel to carry a light's radiance gradient into the parametrisation
+/// ([`crate::shade::light_moments`]). NaN in gives NaN.
+#[inline]
+pub fn unmap_jacobian(p: Vec2) -> (Vec3, Vec3) {
+    let r2 = (p.x * p.x + p.y * p.y).min(2.0 - 1.0 / 4096.0);
+    let s = math::sqrtf(2.0 - r2);
+    let inv = 1.0 / s;
+    let uv = p.x * p.y * inv;
+    (
+        Vec3::new(s - p.x * p.x * inv, -uv, -2.0 * p.x),
+        Vec3::new(-uv, s - p.y * p.y * inv, -2.0 * p.y),
+    )
+}
+
 /// Disk point → texture coordinates in `[0, 1]²` (the disk inscribed in the square).
 #[inline]
 pub fn disk_to_uv(p: Vec2) -> Vec2 {
@@ -122,6 +147,44 @@ pub fn texel_solid_angle(n: u32) -> f32 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn unmap_jacobian_matches_central_differences_and_is_equal_area() {
+        // f64 inverse map (the whole-sphere formula) for the differences.
+        let w = |x: f64, y: f64| {
+            let s = (2.0 - x * x - y * y).sqrt();
+            [x * s, y * s, 1.0 - x * x - y * y]
+        };
+        // The pole, mid-disk, near the horizon, beyond it (the extended map) and near the
+        // antipode.
+        for (x, y) in [
+            (0.0, 0.0),
+            (0.3, -0.4),
+            (-0.7, 0.69),
+            (0.99, 0.05),
+            (1.1, -0.3),
+            (0.9, 1.0),
+        ] {
+            let (ju, jv) = unmap_jacobian(Vec2::new(x as f32, y as f32));
+            let e = 1e-6;
+            for (j, d) in [(ju, (e, 0.0)), (jv, (0.0, e))] {
+                let (a, b) = (w(x + d.0, y + d.1), w(x - d.0, y - d.1));
+                for k in 0..3 {
+                    let fd = (a[k] - b[k]) / (2.0 * e);
+                    assert!(
+                        (f64::from(j[k]) - fd).abs() < 2e-5,
+                        "({x}, {y}) {k}: {j} vs {fd}"
+                    );
+                }
+            }
+            let area = ju.cross(jv).length();
+            assert!((area - 2.0).abs() < 1e-5, "({x}, {y}): area factor {area}");
+        }
+        // The antipode stays finite; NaN propagates.
+        let (a, b) = unmap_jacobian(Vec2::new(core::f32::consts::SQRT_2, 0.0));
+        assert!(a.is_finite() && b.is_finite());
+        assert!(unmap_jacobian(Vec2::new(f32::NAN, 0.0)).0.is_nan());
+    }
 
     #[test]
     fn pole_horizon_and_fallbacks() {

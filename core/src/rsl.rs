@@ -16,7 +16,13 @@
 //! - [`Rsl::solid_angle`]: the solid angle `Ω` of the square, in steradians;
 //! - [`Rsl::energy`]: the light integral `∫_S L dω` over the region, RGB (the paper's
 //!   `2r²·I`; the decomposition makes it exactly the region's integral, so the energy of the
-//!   environment is preserved). [`Rsl::radiance`] gives the paper's average `I = energy/Ω`.
+//!   environment is preserved). [`Rsl::radiance`] gives the paper's average `I = energy/Ω`;
+//! - [`Rsl::gradient`] (an extension, zero by default): a radiance gradient per channel,
+//!   a world-space vector orthogonal to `c`, for the linear light model
+//!   `L(ω) = energy/Ω + G·(ω − c)` over the square that the moments kernel
+//!   ([`crate::shade::light_moments`]) evaluates. The paper's lights are uniform
+//!   (`G = 0`); the harness's decomposition sets `G` by matching the square's first moment
+//!   of radiance to the region's (`harness/src/env/decompose.rs`, "Radiance gradient").
 //!
 //! ## Projection (paper Figure 3 and eq. 6)
 //!
@@ -92,12 +98,14 @@ pub struct Rsl {
     tangent: Vec3,
     solid_angle: f32,
     energy: [f32; 3],
+    gradient: [Vec3; 3],
 }
 
 impl Rsl {
     /// A validated RSL. `centre` is normalised; `tangent` is made orthogonal to it
-    /// (Gram–Schmidt) and normalised; `solid_angle` must lie in `(0, 4π]`; each `energy`
-    /// channel (the light integral `∫_S L dω`) must be finite and non-negative.
+    /// (Gram–Schmidt) and normalised; `solid_angle` must lie in `[f32::MIN_POSITIVE, 4π]`
+    /// (a subnormal one has no finite reciprocal); each `energy` channel (the light
+    /// integral `∫_S L dω`) must be finite and non-negative.
     pub fn new(
         centre: Vec3,
         tangent: Vec3,
@@ -117,7 +125,8 @@ impl Rsl {
                 what: "RSL solid angle",
             });
         }
-        if solid_angle <= 0.0 || solid_angle > MAX_SOLID_ANGLE {
+        // Subnormal solid angles are rejected too: their reciprocal overflows.
+        if !(f32::MIN_POSITIVE..=MAX_SOLID_ANGLE).contains(&solid_angle) {
             return Err(Error::OutOfRange {
                 what: "RSL solid angle",
                 value: solid_angle,
@@ -143,7 +152,25 @@ impl Rsl {
             tangent: t,
             solid_angle,
             energy,
+            gradient: [Vec3::ZERO; 3],
         })
+    }
+
+    /// The same light with the radiance gradient `G` per channel (module docs): the
+    /// component of each vector along the centre is removed (the model is first order in
+    /// the tangent plane). Errors: a non-finite component, before or after that projection
+    /// (which overflows only for components near `f32::MAX`).
+    pub fn with_gradient(mut self, gradient: [Vec3; 3]) -> Result<Rsl, Error> {
+        for (g, out) in gradient.iter().zip(&mut self.gradient) {
+            let t = *g - self.centre * self.centre.dot(*g);
+            if !g.is_finite() || !t.is_finite() {
+                return Err(Error::NonFinite {
+                    what: "RSL radiance gradient",
+                });
+            }
+            *out = t;
+        }
+        Ok(self)
     }
 
     /// Unit centre direction `c` (world space).
@@ -165,6 +192,12 @@ impl Rsl {
     #[inline]
     pub fn energy(&self) -> [f32; 3] {
         self.energy
+    }
+    /// Radiance gradient per channel, world space, orthogonal to the centre (zero unless
+    /// set by [`Rsl::with_gradient`]; module docs).
+    #[inline]
+    pub fn gradient(&self) -> [Vec3; 3] {
+        self.gradient
     }
     /// Luminance of [`Rsl::energy`].
     #[inline]
@@ -362,6 +395,7 @@ mod tests {
             Rsl::new(Vec3::Z, Vec3::Z, 0.1, [1.0; 3]),
             Rsl::new(Vec3::Z, Vec3::new(f32::NAN, 0.0, 0.0), 0.1, [1.0; 3]),
             Rsl::new(Vec3::Z, Vec3::X, 0.0, [1.0; 3]),
+            Rsl::new(Vec3::Z, Vec3::X, 1e-40, [1.0; 3]), // subnormal: 1/Ω overflows
             Rsl::new(Vec3::Z, Vec3::X, 13.0, [1.0; 3]),
             Rsl::new(Vec3::Z, Vec3::X, f32::NAN, [1.0; 3]),
             Rsl::new(Vec3::Z, Vec3::X, 0.1, [1.0, -1.0, 0.0]),
@@ -370,6 +404,18 @@ mod tests {
         for b in bad {
             assert!(b.is_err(), "{b:?}");
         }
+        // The gradient: zero by default, projected onto the tangent plane, finite only.
+        assert_eq!(r.gradient(), [Vec3::ZERO; 3]);
+        let g = r
+            .with_gradient([Vec3::new(1.0, 2.0, 3.0), Vec3::Z, Vec3::ZERO])
+            .unwrap()
+            .gradient();
+        assert_eq!(g, [Vec3::new(1.0, 2.0, 0.0), Vec3::ZERO, Vec3::ZERO]);
+        assert!(r.with_gradient([Vec3::X, Vec3::NAN, Vec3::X]).is_err());
+        assert!(
+            r.with_gradient([Vec3::new(f32::INFINITY, 0.0, 0.0), Vec3::X, Vec3::X])
+                .is_err()
+        );
     }
 
     #[test]

@@ -181,14 +181,24 @@ pub fn point_vdt(scene: &Scene, p: &ShadePoint, n: usize) -> Vdt {
     Vdt::build(n, n, &point_mask(scene, p, n)).expect("valid map")
 }
 
-/// The visibility moment tables of a point ([`VisMoments`]) over the same `n × n` binary
-/// map as [`point_vdt`].
+/// The visibility moment tables of a point ([`VisMoments`]) over its `n × n` coverage map
+/// ([`point_coverage`]; the binary map of [`point_vdt`] moves every shadow edge by up to
+/// half a texel, [`VisMoments::build_coverage`]).
 pub fn point_moments(scene: &Scene, p: &ShadePoint, n: usize) -> VisMoments {
-    VisMoments::build(n, &point_mask(scene, p, n)).expect("valid map")
+    VisMoments::build_coverage(n, &point_coverage(scene, p, n)).expect("valid map")
 }
 
 /// The binary visibility map of a point on an `n × n` grid (module docs of [`point_vdt`]).
 pub fn point_mask(scene: &Scene, p: &ShadePoint, n: usize) -> Vec<bool> {
+    let cov = point_coverage(scene, p, n);
+    let mut mask = vec![false; n * n];
+    binary_into(&cov, &mut mask);
+    mask
+}
+
+/// The coverage map of a point on an `n × n` grid: the visible fraction of each texel
+/// (the union of its occluders' caps, [`coverage_into`], [`Outside::Visible`]).
+pub fn point_coverage(scene: &Scene, p: &ShadePoint, n: usize) -> Vec<f32> {
     let caps: Vec<_> = p
         .occluders
         .iter()
@@ -205,9 +215,7 @@ pub fn point_mask(scene: &Scene, p: &ShadePoint, n: usize) -> Vec<bool> {
         .collect();
     let mut cov = vec![0.0f32; n * n];
     coverage_into(&caps, n, Outside::Visible, &mut cov).expect("valid grid");
-    let mut mask = vec![false; n * n];
-    binary_into(&cov, &mut mask);
-    mask
+    cov
 }
 
 /// Sub-texel samples of a cube map: direction, exact solid angle, texel index.
@@ -301,22 +309,34 @@ pub fn par_map<T: Sync, R: Send>(items: &[T], f: impl Fn(&T) -> R + Sync) -> Vec
     out.into_iter().flatten().collect()
 }
 
-/// Exact square means for one point and one light, `f64`:
-/// `(ρ̄, V̄, joint)` with `joint = (1/Ω)∫_R ρcos·V dω` (midpoint rule, `m × m`).
+/// Exact square integrals for one point and one light, `f64` (midpoint rule, `m × m`).
+struct ExactSquare {
+    /// `ρ̄ = (1/Ω)∫_R ρcos dω`.
+    rho: f64,
+    /// `V̄`, the visible fraction of the square.
+    vis: f64,
+    /// `(1/Ω)∫_R ρcos·V dω`.
+    joint: f64,
+    /// `∫_R ρcos·V·(ω − c) dω` (world), the first moment that the light's radiance gradient
+    /// multiplies.
+    moment: DVec3,
+}
+
 fn exact_square(
     scene: &Scene,
     p: &ShadePoint,
     brdf: &dyn Brdf,
     wo: Vec3,
-    centre: Vec2,
-    r: f32,
+    light: &ShadeLight,
+    (centre, r): (Vec2, f32),
     m: usize,
-) -> (f64, f64, f64) {
+) -> ExactSquare {
     let h = f64::from(r) * FRAC_1_SQRT_2;
     let c = centre.as_dvec2();
+    let lc = light.centre().as_dvec3();
     let step = 2.0 * h / m as f64;
     let (t, b, n) = p.axes();
-    let (mut sr, mut sv, mut sj) = (0.0, 0.0, 0.0);
+    let (mut sr, mut sv, mut sj, mut sm) = (0.0, 0.0, 0.0, DVec3::ZERO);
     for j in 0..m {
         for i in 0..m {
             let q = c + DVec2::new(-h + step * (i as f64 + 0.5), -h + step * (j as f64 + 0.5));
@@ -331,15 +351,17 @@ fn exact_square(
             sr += rho;
             sv += vis;
             sj += rho * vis;
+            sm += (d - lc) * (rho * vis);
         }
     }
-    let cell = step * step;
+    let dw = 2.0 * step * step; // dω = 2·du·dv
     let omega = 8.0 * h * h; // 2·(2h)²
-    (
-        2.0 * sr * cell / omega,
-        sv / (m * m) as f64,
-        2.0 * sj * cell / omega,
-    )
+    ExactSquare {
+        rho: sr * dw / omega,
+        vis: sv / (m * m) as f64,
+        joint: sj * dw / omega,
+        moment: sm * dw,
+    }
 }
 
 /// The estimates compared in the factor analysis, per point, RGB.
@@ -350,6 +372,9 @@ pub enum Variant {
     MultiProduct,
     /// Light uniform over the square: `Σ Eᵢ·(1/Ωᵢ)∫_{Rᵢ} ρV` (only the light's region → square).
     SquareJoint,
+    /// The linear light of the moments kernel over the square, exact `ρV`:
+    /// `Σ Eᵢ·(1/Ωᵢ)∫_{Rᵢ} ρV + Gᵢ·∫_{Rᵢ} ρV·(ω − cᵢ)` (the floor of [`Variant::Moments`]).
+    SquareLinear,
     /// Eq. 5 with exact square means: `Σ Eᵢ·ρ̄ᵢ·V̄ᵢ` (square + multi-product, exact factors).
     SquareExact,
     /// BRDF SAT, exact square visibility.
@@ -360,15 +385,16 @@ pub enum Variant {
     Kernel,
     /// The kernel with the paper's eq. 9 VDT query.
     KernelEq9,
-    /// The visibility-moments kernel: BRDF SAT with its gradient × visibility fraction and
-    /// first moment ([`shade::shade_moments`]).
+    /// The moments kernel: BRDF SAT with its gradient, visibility fraction and first moment
+    /// from the coverage map, the light's radiance gradient ([`shade::shade_moments`]).
     Moments,
 }
 
 /// Every variant, in the order of [`PointResult::values`].
-pub const VARIANTS: [Variant; 8] = [
+pub const VARIANTS: [Variant; 9] = [
     Variant::MultiProduct,
     Variant::SquareJoint,
+    Variant::SquareLinear,
     Variant::SquareExact,
     Variant::SatExactV,
     Variant::ExactBrdfVdt,
@@ -539,23 +565,33 @@ pub fn analyse(setup: &Setup<'_>, decs: &[&Decomposition], settings: Settings) -
                 let sat = f64::from(setup.sat.integral(wo, pc, r) * l.inv_solid_angle());
                 let vg = f64::from(shade::SquareVisibility::fraction(&vis_g, pc, r));
                 let v9 = f64::from(shade::SquareVisibility::fraction(&vis_9, pc, r));
+                // Scalar factors per variant (times Eᵢ), and the RGB terms of the linear
+                // light (added as they are).
                 let mut f = [0.0f64; VARIANTS.len()];
+                let mut rgb = [[0.0f64; 3]; VARIANTS.len()];
                 if settings.exact_squares {
-                    let (er, ev, ej) =
-                        exact_square(setup.scene, p, setup.brdf, wo, pc, r, settings.square_cells);
-                    f[1] = ej;
-                    f[2] = er * ev;
-                    f[3] = sat * ev;
-                    f[4] = er * vg;
+                    let ex = exact_square(
+                        setup.scene,
+                        p,
+                        setup.brdf,
+                        wo,
+                        l,
+                        (pc, r),
+                        settings.square_cells,
+                    );
+                    f[1] = ex.joint;
+                    f[2] = ex.joint;
+                    rgb[2] = l.gradient().map(|g| g.as_dvec3().dot(ex.moment));
+                    f[3] = ex.rho * ex.vis;
+                    f[4] = sat * ex.vis;
+                    f[5] = ex.rho * vg;
                 }
-                f[5] = sat * vg;
-                f[6] = sat * v9;
-                f[7] = f64::from(shade::light_factor_moments(
-                    &p.frame, wo, setup.sat, &vis_m, l,
-                ));
+                f[6] = sat * vg;
+                f[7] = sat * v9;
+                rgb[8] = shade::light_moments(&p.frame, wo, setup.sat, &vis_m, l).map(f64::from);
                 for v in 1..VARIANTS.len() {
                     for c in 0..3 {
-                        res.values[v][c] += e[c] * f[v];
+                        res.values[v][c] += e[c] * f[v] + rgb[v][c];
                     }
                 }
             }

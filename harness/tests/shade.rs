@@ -113,7 +113,6 @@ fn check_k30(e: &Env, variant: Variant) {
 }
 
 #[test]
-#[ignore = "fails: measured 0.56 % with the moments kernel (0.73 % with eq. 5); the exact integral over the K = 30 uniform squares is already 0.51 % (SquareJoint): see the report's shading section"]
 fn k30_default_sky_within_0_35_percent() {
     check_k30(sky(), Variant::Moments);
 }
@@ -129,9 +128,10 @@ fn k30_real_hdr_within_0_35_percent_eq5_kernel() {
     check_k30(real(), Variant::Kernel);
 }
 
-/// The moments kernel keeps the covariance that eq. 5 drops: at K = 30 it is at least 20 %
-/// more accurate than the eq. 5 kernel on both environments, and within 0.1 percentage
-/// points of the exact integral over the same squares (`SquareJoint`, its floor).
+/// The moments kernel keeps the covariances that eq. 5 drops: at K = 30 it is at least
+/// 20 % more accurate than the eq. 5 kernel on both environments, and within 0.1
+/// percentage points of the exact integral of its own light model over the same squares
+/// (`SquareLinear`, its floor).
 #[test]
 fn moments_kernel_beats_eq5_and_nears_the_square_floor() {
     for e in [sky(), real()] {
@@ -139,10 +139,10 @@ fn moments_kernel_beats_eq5_and_nears_the_square_floor() {
         let (m, k, floor) = (
             e.analysis.error(d, Variant::Moments),
             e.analysis.error(d, Variant::Kernel),
-            e.analysis.error(d, Variant::SquareJoint),
+            e.analysis.error(d, Variant::SquareLinear),
         );
         say(&format!(
-            "{}: K = 30 moments {:.3} %, eq. 5 {:.3} %, square floor {:.3} %",
+            "{}: K = 30 moments {:.3} %, eq. 5 {:.3} %, linear-light square floor {:.3} %",
             e.name,
             100.0 * m,
             100.0 * k,
@@ -151,6 +151,38 @@ fn moments_kernel_beats_eq5_and_nears_the_square_floor() {
         assert!(m <= 0.8 * k, "{}: {m} vs {k}", e.name);
         assert!(m <= floor + 0.001, "{}: {m} vs floor {floor}", e.name);
     }
+}
+
+/// The radiance gradient of the decomposition (moment-matched, `env::decompose` module
+/// docs) lowers the light model's own floor: the exact integral over the squares with the
+/// linear light is never worse than with the paper's uniform light at any K, and on the
+/// default sky at K = 30 (a horizon-brightened sky in a few large regions) at least 30 %
+/// better.
+#[test]
+fn radiance_gradient_lowers_the_square_floor() {
+    for e in [sky(), real()] {
+        for d in 0..e.decs.len() {
+            let (lin, uni) = (
+                e.analysis.error(d, Variant::SquareLinear),
+                e.analysis.error(d, Variant::SquareJoint),
+            );
+            say(&format!(
+                "{} K = {}: square floor, linear light {:.3} %, uniform {:.3} %",
+                e.name,
+                e.decs[d].k,
+                100.0 * lin,
+                100.0 * uni
+            ));
+            assert!(lin <= uni, "{} K = {}: {lin} > {uni}", e.name, e.decs[d].k);
+        }
+    }
+    let s = sky();
+    let d = k_index(s, 30);
+    let (lin, uni) = (
+        s.analysis.error(d, Variant::SquareLinear),
+        s.analysis.error(d, Variant::SquareJoint),
+    );
+    assert!(lin <= 0.7 * uni, "default sky K = 30: {lin} vs {uni}");
 }
 
 fn check_decreasing(e: &Env) {

@@ -248,6 +248,7 @@ pub fn section(opts: &Options) -> Result<Section, Box<dyn Error>> {
             "<h3>{}</h3><table><tr><th>merge</th><th>K</th><th>kernel</th><th>kernel, eq. 9 VDT</th>\
              <th>eq. 13 bound</th><th>multi-product (true regions)</th><th>square, light only</th>\
              <th>square, exact ρ̄ and V̄</th><th>SAT ρ̄, exact V̄</th><th>exact ρ̄, VDT V̄</th>\
+             <th>linear light over the square, exact ρV</th>\
              <th>moments kernel</th><th>paper Fig. 9 / 10</th></tr>",
             e.name
         );
@@ -258,7 +259,7 @@ pub fn section(opts: &Options) -> Result<Section, Box<dyn Error>> {
                 html,
                 "<tr><td>{obj:?}</td><td>{k}</td><td><b>{:.3} %</b></td><td>{:.3} %</td><td>{:.3} %</td>\
                  <td>{:.3} %</td><td>{:.3} %</td><td>{:.3} %</td><td>{:.3} %</td><td>{:.3} %</td>\
-                 <td><b>{:.3} %</b></td><td>{}</td></tr>",
+                 <td>{:.3} %</td><td><b>{:.3} %</b></td><td>{}</td></tr>",
                 100.0 * er[vi(Variant::Kernel)],
                 100.0 * er[vi(Variant::KernelEq9)],
                 100.0 * row.bound,
@@ -267,18 +268,20 @@ pub fn section(opts: &Options) -> Result<Section, Box<dyn Error>> {
                 100.0 * er[vi(Variant::SquareExact)],
                 100.0 * er[vi(Variant::SatExactV)],
                 100.0 * er[vi(Variant::ExactBrdfVdt)],
+                100.0 * er[vi(Variant::SquareLinear)],
                 100.0 * er[vi(Variant::Moments)],
                 p.map_or(String::new(), |p| format!("{:.2} % / {:.2} %", p.1, p.2)),
             );
             let _ = writeln!(
                 summary,
-                "shade {:<22} {:<5} K = {k:3}: error {:.3} % (eq. 9 VDT {:.3} %, moments kernel {:.3} %, exact over the squares {:.3} %), eq. 13 bound {:.3} % (multi-product {:.3} %)",
+                "shade {:<22} {:<5} K = {k:3}: error {:.3} % (eq. 9 VDT {:.3} %, moments kernel {:.3} %, exact over the squares {:.3} % uniform / {:.3} % linear light), eq. 13 bound {:.3} % (multi-product {:.3} %)",
                 e.name,
                 format!("{obj:?}"),
                 100.0 * er[vi(Variant::Kernel)],
                 100.0 * er[vi(Variant::KernelEq9)],
                 100.0 * er[vi(Variant::Moments)],
                 100.0 * er[vi(Variant::SquareJoint)],
+                100.0 * er[vi(Variant::SquareLinear)],
                 100.0 * row.bound,
                 100.0 * er[vi(Variant::MultiProduct)],
             );
