@@ -1,6 +1,7 @@
 //! RSL shading (`steradian_core::shade`): scalar vs SIMD (8 points per call) over the same
-//! points × K lights, for a diffuse and a glossy BRDF SAT. Throughput is in RSL evaluations
-//! (points × K) per second.
+//! points × K lights, for a diffuse and a glossy BRDF SAT, and the scalar moments kernel
+//! (`shade_moments`: linear BRDF, linear light, visibility moments) beside them. Throughput
+//! is in RSL evaluations (points × K) per second.
 //!
 //! `cargo bench -p steradian-benches --bench shade`
 
@@ -19,6 +20,7 @@ fn bench(c: &mut Criterion) {
     let decs = decompose::decompose(&cube, &decompose::Options::quiet(&ks)).unwrap();
     let scene = Scene::standard(12);
     let vdts = sh::par_map(&scene.points, |p| sh::point_vdt(&scene, p, 128));
+    let moments = sh::par_map(&scene.points, |p| sh::point_moments(&scene, p, 128));
     let materials: [(&str, Box<dyn Brdf>); 2] = [
         ("lambert", Box::new(Lambert::new(0.8).unwrap())),
         ("phong30", Box::new(Phong::new(0.3, 0.5, 30.0).unwrap())),
@@ -45,6 +47,15 @@ fn bench(c: &mut Criterion) {
                     for (p, v) in scene.points.iter().zip(&vdts) {
                         let vis = VdtVisibility::new(v.view(), VdtQuery::Gradient).unwrap();
                         s += shade::shade(&p.frame, p.wo, &sat, &vis, black_box(&lights))[1];
+                    }
+                    s
+                })
+            });
+            g.bench_function(format!("{mname}/K{}/moments_scalar", d.k), |b| {
+                b.iter(|| {
+                    let mut s = 0.0f32;
+                    for (p, m) in scene.points.iter().zip(&moments) {
+                        s += shade::shade_moments(&p.frame, p.wo, &sat, m, black_box(&lights))[1];
                     }
                     s
                 })
