@@ -372,17 +372,7 @@ impl<'a> SatView<'a> {
         let (yl, yh) = (y0.min(y1), y0.max(y1));
         if xh < w && yh < h {
             // Inside the table (so `xl ≤ xh < w`, `yl ≤ yh < h`): four plain lookups.
-            let w1 = w + 1;
-            let (r0, r1) = (yl * w1, yh * w1);
-            let at = |k: usize| self.sums.get(k).copied();
-            match (at(r0 + xl), at(r0 + xh), at(r1 + xl), at(r1 + xh)) {
-                (Some(s00), Some(s10), Some(s01), Some(s11)) => {
-                    let s = s11.wrapping_sub(s01).wrapping_sub(s10.wrapping_sub(s00));
-                    (s as f64 * self.scale) as f32
-                }
-                // Only for a corrupt `SatView` (entries checked at construction).
-                _ => 0.0,
-            }
+            (self.integer_box(xl, xh, yl, yh) as f64 * self.scale) as f32
         } else {
             // Corners clipped to at most 2^24 (MAX_SIDE): exact in f32.
             let (x0, x1, y0, y1) = (x0.min(w), x1.min(w), y0.min(h), y1.min(h));
