@@ -560,19 +560,25 @@ mod tests {
         }
     }
 
+    /// The prepared light, its square's centre and half-side at `f`, and the plane BRDF
+    /// density of the two exactness tests.
+    fn linear_setup(f: &Frame, l: &Rsl) -> (ShadeLight, Vec2, f32, Linear) {
+        let light = ShadeLight::from(l);
+        let (c, r) = light.square_above_horizon(f).unwrap();
+        let b = Linear {
+            a: 0.5,
+            g: Vec2::new(-0.4, 0.2),
+        };
+        (light, c, r * core::f32::consts::FRAC_1_SQRT_2, b)
+    }
+
     /// `I·f + |R|·g·m` is exact for a linear density: over the right half of a square of
     /// half-side `h`, `∫φ = φ(c)·2h² + g_x·h³`; eq. 5's product of means misses `g_x·h³`.
     #[test]
     fn moments_kernel_is_exact_for_a_linear_density() {
         let f = Frame::from_normal(Vec3::Z).unwrap();
         let l = Rsl::new(Vec3::new(0.3, -0.2, 1.0), Vec3::X, 0.4, [1.0, 2.0, 0.5]).unwrap();
-        let light = ShadeLight::from(&l);
-        let (c, r) = light.square_above_horizon(&f).unwrap();
-        let h = r * core::f32::consts::FRAC_1_SQRT_2;
-        let b = Linear {
-            a: 0.5,
-            g: Vec2::new(-0.4, 0.2),
-        };
+        let (light, c, h, b) = linear_setup(&f, &l);
         let exact = ((b.a + b.g.dot(c)) * 2.0 * h * h + b.g.x * h * h * h) * light.inv_solid_angle;
         let got = light_moments(&f, Vec3::Z, &b, &RightHalf, &light);
         for (g, e) in got.iter().zip(l.energy()) {
@@ -613,13 +619,7 @@ mod tests {
             .unwrap()
             .with_gradient(grad)
             .unwrap();
-        let light = ShadeLight::from(&l);
-        let (c, r) = light.square_above_horizon(&f).unwrap();
-        let h = r * core::f32::consts::FRAC_1_SQRT_2;
-        let b = Linear {
-            a: 0.5,
-            g: Vec2::new(-0.4, 0.2),
-        };
+        let (light, c, h, b) = linear_setup(&f, &l);
         let phi_c = b.a + b.g.dot(c);
         let got = light_moments(&f, Vec3::Z, &b, &RightHalf, &light);
         let centre = l.centre();
