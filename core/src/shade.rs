@@ -388,7 +388,7 @@ where
     let joint = i * f + area * g.dot(m);
     // ∫φV lies in [0, ∫φ] for φ ≥ 0, 0 ≤ V ≤ 1 (both comparisons are false for NaN,
     // which stays NaN).
-    let joint = clamp_below(joint, i) * light.inv_solid_angle;
+    let joint = clamp_keep_nan(joint, i) * light.inv_solid_angle;
     let mut out = [
         light.energy[0] * joint,
         light.energy[1] * joint,
@@ -401,7 +401,7 @@ where
         let (ju, jv) = crate::hemisphere::unmap_jacobian(p);
         let u = frame.to_world(ju * w.x + jv * w.y);
         for (o, gc) in out.iter_mut().zip(&light.gradient) {
-            *o = clamp_below(*o + gc.dot(u), f32::INFINITY);
+            *o = clamp_keep_nan(*o + gc.dot(u), f32::INFINITY);
         }
     }
     out
@@ -409,7 +409,7 @@ where
 
 /// `x` clamped to `[0, hi]`; NaN stays NaN.
 #[inline(always)]
-fn clamp_below(x: f32, hi: f32) -> f32 {
+fn clamp_keep_nan(x: f32, hi: f32) -> f32 {
     if x < 0.0 {
         0.0
     } else if x > hi {
