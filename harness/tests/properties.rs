@@ -4,7 +4,10 @@
 use std::f64::consts::{FRAC_PI_2, PI};
 
 use proptest::prelude::*;
-use proptest::test_runner::{Config, RngSeed};
+use proptest::test_runner::Config;
+
+#[path = "common/proptest_config.rs"]
+mod proptest_config;
 use steradian_core::cap::{self, CapFit, SphericalCap};
 use steradian_core::frame::Frame;
 use steradian_core::lobe::{self, CosineLobe, Lafortune, LafortuneLobe, Phong};
@@ -13,15 +16,7 @@ use steradian_harness::workload::{self, unit32};
 use steradian_harness::{accuracy, reference};
 
 fn config() -> Config {
-    Config {
-        cases: std::env::var("PROPTEST_CASES")
-            .ok()
-            .and_then(|s| s.parse().ok())
-            .unwrap_or(4000),
-        rng_seed: RngSeed::Fixed(0x5732_ad1a),
-        failure_persistence: None,
-        ..Config::default()
-    }
+    proptest_config::config(4000, 0x5732_ad1a)
 }
 
 /// A direction of any length from 1e-30 to 1e30, any hemisphere.

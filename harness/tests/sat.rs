@@ -5,7 +5,10 @@
 //! `steradian eval sat-box`.
 
 use proptest::prelude::*;
-use proptest::test_runner::{Config, RngSeed};
+use proptest::test_runner::Config;
+
+#[path = "common/proptest_config.rs"]
+mod proptest_config;
 use serde_json::{Value, json};
 use steradian_core::Vec2;
 use steradian_core::sat::{Sat, SatView};
@@ -22,15 +25,7 @@ mod gpu_common;
 use gpu_common::{gpu, say};
 
 fn config(cases: u32) -> Config {
-    Config {
-        cases: std::env::var("PROPTEST_CASES")
-            .ok()
-            .and_then(|s| s.parse().ok())
-            .unwrap_or(cases),
-        rng_seed: RngSeed::Fixed(0x5a7_ad1a),
-        failure_persistence: None,
-        ..Config::default()
-    }
+    proptest_config::config(cases, 0x5a7_ad1a)
 }
 
 fn build(g: &Grid) -> Sat {

@@ -5,7 +5,10 @@
 use std::f64::consts::{FRAC_PI_2, PI, TAU};
 
 use proptest::prelude::*;
-use proptest::test_runner::{Config, RngSeed};
+use proptest::test_runner::Config;
+
+#[path = "common/proptest_config.rs"]
+mod proptest_config;
 use steradian_core::Vec3;
 use steradian_core::cap::SphericalCap;
 use steradian_core::frame::Frame;
@@ -23,15 +26,7 @@ fn eval_vdt_box(line: &str) -> Result<serde_json::Value, String> {
 }
 
 fn config(cases: u32) -> Config {
-    Config {
-        cases: std::env::var("PROPTEST_CASES")
-            .ok()
-            .and_then(|s| s.parse().ok())
-            .unwrap_or(cases),
-        rng_seed: RngSeed::Fixed(0x0bd7_0004),
-        failure_persistence: None,
-        ..Config::default()
-    }
+    proptest_config::config(cases, 0x0bd7_0004)
 }
 
 fn edt(w: usize, h: usize, mask: &[bool]) -> Vec<f32> {
