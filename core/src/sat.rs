@@ -73,9 +73,9 @@
 //! conversions and 10 `f64` operations (out of line). A query whose four corners are
 //! integers strictly inside the far edges is the four lookups of eq. 2, inlined: three
 //! exact `i64` operations, one conversion, one scaling, one rounding (the same bits as the
-//! general path); [`SatView::box_sum_cells`] is that query for `usize` corners, without
-//! the float-to-index work. The table takes 8 bytes per entry, `(width + 1)·(height + 1)`
-//! entries.
+//! general path); [`SatView::box_sum_cells`] is that query for `usize` corners (exact up to
+//! the far edges too), without the float-to-index work. The table takes 8 bytes per entry,
+//! `(width + 1)·(height + 1)` entries.
 
 use crate::math;
 use crate::{Error, Vec2};
@@ -359,25 +359,46 @@ impl<'a> SatView<'a> {
 
     /// The integral over the box between the integer corners `(x0, y0)` and `(x1, y1)`
     /// (texel units, any order, clipped to the table): the integer-coordinate query the
-    /// other summed-area-table crates offer. The same bits as
-    /// `box_sum(x0 as f32, y0 as f32, x1 as f32, y1 as f32)` for every input, at the cost
-    /// of a plain four-lookup query (no float-to-index work): the exact `i64` box sum,
-    /// rounded once. A box reaching the last column or row (`x = width` or `y = height`)
-    /// takes [`SatView::box_sum`]'s general path, as that query does (its result can
-    /// differ from the exact integer sum by the `f64` rounding of the bound).
+    /// other summed-area-table crates offer. The exact `i64` box sum rounded once to `f32`:
+    /// the bound of the module docs without its `2⁻⁴⁶·A` term (there is no `f64`
+    /// combination), `2⁻²⁴·|I| + 2⁻¹⁵⁰ + n·2⁻⁵⁹·T`.
+    /// The same bits as `box_sum(x0 as f32, y0 as f32, x1 as f32, y1 as f32)` when both
+    /// corners lie before the last column and row; a box reaching `x = width` or
+    /// `y = height` is read exactly here, where `box_sum` weights the last texel by a
+    /// fraction of 1 and may round its `f64` combination (within that query's bound).
+    ///
+    /// Ordered corners inside the table are the four lookups of eq. 2 behind four
+    /// compare-and-branch tests; inverted or clipped boxes take an out-of-line path that
+    /// orders and clips the corners and comes back.
     #[inline(always)]
     pub fn box_sum_cells(&self, x0: usize, y0: usize, x1: usize, y1: usize) -> f32 {
         let (w, h) = (self.width, self.height);
-        let (xl, xh) = (x0.min(x1), x0.max(x1));
-        let (yl, yh) = (y0.min(y1), y0.max(y1));
-        if xh < w && yh < h {
-            // Inside the table (so `xl ≤ xh < w`, `yl ≤ yh < h`): four plain lookups.
-            (self.integer_box(xl, xh, yl, yh) as f64 * self.scale) as f32
-        } else {
-            // Corners clipped to at most 2^24 (MAX_SIDE): exact in f32.
-            let (x0, x1, y0, y1) = (x0.min(w), x1.min(w), y0.min(h), y1.min(h));
-            self.fractional_box(x0 as f32, y0 as f32, x1 as f32, y1 as f32) as f32
+        if x0 <= x1 && x1 <= w && y0 <= y1 && y1 <= h {
+            // `x0 ≤ x1 ≤ w`, `y0 ≤ y1 ≤ h`: every index is inside the table, and no
+            // product overflows (the table has `(w + 1)·(h + 1)` entries). `b` runs from
+            // `(0, y0)` to `(x1, y1)`, so the four reads sit at `x` and `d + x` and the
+            // compiler keeps one range check instead of four.
+            let w1 = w + 1;
+            let d = (y1 - y0) * w1;
+            let r0 = y0 * w1;
+            if let Some(b) = self.sums.get(r0..).and_then(|s| s.get(..=d + x1)) {
+                let k = b[d + x1]
+                    .wrapping_sub(b[d + x0])
+                    .wrapping_sub(b[x1].wrapping_sub(b[x0]));
+                return (k as f64 * self.scale) as f32;
+            }
         }
+        self.box_sum_cells_general(x0, y0, x1, y1)
+    }
+
+    /// The rest of [`SatView::box_sum_cells`]: orders and clips the corners, then takes
+    /// the four lookups (out of line, so the ordered in-table query stays small).
+    #[inline(never)]
+    fn box_sum_cells_general(&self, x0: usize, y0: usize, x1: usize, y1: usize) -> f32 {
+        let (w, h) = (self.width, self.height);
+        let (xl, xh) = (x0.min(x1).min(w), x0.max(x1).min(w));
+        let (yl, yh) = (y0.min(y1).min(h), y0.max(y1).min(h));
+        (self.integer_box(xl, xh, yl, yh) as f64 * self.scale) as f32
     }
 
     /// `S(I1,J1) − S(I0,J1) − S(I1,J0) + S(I0,J0)` in quanta, exact (wrapping) `i64`, for

@@ -3,6 +3,7 @@
 //! corners: fractional, outside the table, inverted, raw `f32` bits including NaN and ±∞):
 //! within the documented bound `2⁻²⁴·|I| + 2⁻¹⁵⁰ + 2⁻⁴⁶·A + n·2⁻⁵⁹·T`, NaN exactly when a corner
 //! is NaN, the same for every order of the corners, and the SIMD kernel bit-identical.
+//! Integer corners through `box_sum_cells` likewise (exact up to the far edges).
 //! Non-finite texels must be rejected by the builder; nothing may panic.
 #![no_main]
 
@@ -111,6 +112,50 @@ fuzz_target!(|data: &[u8]| {
             assert!(
                 ((got as f64) - exact).abs() <= bound,
                 "{w}×{h} box ({u0}, {v0}, {u1}, {v1}): got {got}, exact {exact}, bound {bound}"
+            );
+        }
+    }
+    // Integer corners (`box_sum_cells`, any order, up to two past the far edge): the
+    // brute-force sum within the bound, order-independent, and `box_sum`'s bits while
+    // both corners lie before the last column and row.
+    for chunk in boxes.chunks_exact(16).take(16) {
+        let q: [usize; 4] =
+            core::array::from_fn(|k| chunk[4 * k] as usize % (if k % 2 == 0 { w } else { h } + 3));
+        let got = sat.box_sum_cells(q[0], q[1], q[2], q[3]);
+        for other in [
+            sat.box_sum_cells(q[2], q[3], q[0], q[1]),
+            sat.box_sum_cells(q[2], q[1], q[0], q[3]),
+            sat.box_sum_cells(q[0], q[3], q[2], q[1]),
+        ] {
+            assert_eq!(other.to_bits(), got.to_bits(), "cells {q:?}");
+        }
+        let f = q.map(|c| c as f32);
+        if q[0].max(q[2]) < w && q[1].max(q[3]) < h {
+            let want = sat.box_sum(f[0], f[1], f[2], f[3]);
+            assert_eq!(
+                got.to_bits(),
+                want.to_bits(),
+                "cells {q:?}: {got} vs {want}"
+            );
+        }
+        let (x0, x1) = (q[0].min(q[2]).min(w), q[0].max(q[2]).min(w));
+        let (y0, y1) = (q[1].min(q[3]).min(h), q[1].max(q[3]).min(h));
+        let (mut exact, mut abs_read) = (0.0f64, 0.0f64);
+        for j in y0..y1 {
+            for i in x0..x1 {
+                exact += texels[j * w + i] as f64;
+                abs_read += (texels[j * w + i] as f64).abs();
+            }
+        }
+        let n = ((x1 - x0) * (y1 - y0)) as f64;
+        let bound = exact.abs() * 2f64.powi(-24)
+            + 2f64.powi(-150)
+            + n * 2f64.powi(-59) * total
+            + abs_read * 81.0 * 2f64.powi(-52);
+        if exact.abs() <= f32::MAX as f64 * 0.99 {
+            assert!(
+                ((got as f64) - exact).abs() <= bound,
+                "{w}×{h} cells {q:?}: got {got}, exact {exact}, bound {bound}"
             );
         }
     }
