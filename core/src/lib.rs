@@ -73,7 +73,6 @@ pub mod sat;
 pub mod shade;
 pub mod table;
 pub mod vdt;
-#[cfg(feature = "alloc")]
 pub mod vis_moments;
 pub mod visibility;
 pub mod wgsl;

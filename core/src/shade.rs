@@ -144,6 +144,13 @@ pub trait SquareMoments {
     fn moments(&self, centre: Vec2, half_diagonal: f32) -> (f32, Vec2);
 }
 
+impl SquareMoments for crate::vis_moments::VisMomentsView<'_> {
+    #[inline]
+    fn moments(&self, centre: Vec2, half_diagonal: f32) -> (f32, Vec2) {
+        crate::vis_moments::VisMomentsView::moments(self, centre, half_diagonal)
+    }
+}
+
 #[cfg(feature = "alloc")]
 impl SquareMoments for crate::vis_moments::VisMoments {
     #[inline]

@@ -46,12 +46,16 @@
 //! **Bad input.** Construction validates the size; NaN in a query gives NaN; a zero or
 //! negative half-diagonal (an empty square) gives `f = 1`, `m = 0`. Nothing panics.
 
+#[cfg(feature = "alloc")]
 use alloc::vec::Vec;
 
+#[cfg(feature = "alloc")]
 use crate::sat::Sat;
+use crate::sat::SatView;
 use crate::{Error, Vec2};
 
 /// Three exact summed-area tables of a visibility map: `V`, `u·V`, `v·V` (module docs).
+#[cfg(feature = "alloc")]
 #[derive(Clone, Debug, PartialEq)]
 pub struct VisMoments {
     n: usize,
@@ -60,6 +64,17 @@ pub struct VisMoments {
     yv: Sat,
 }
 
+/// The query side of [`VisMoments`], borrowed (what a renderer without `alloc` keeps, and
+/// what the SIMD kernel reads): the three tables as [`SatView`]s of one `n × n` map.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct VisMomentsView<'a> {
+    n: usize,
+    v: SatView<'a>,
+    xv: SatView<'a>,
+    yv: SatView<'a>,
+}
+
+#[cfg(feature = "alloc")]
 impl VisMoments {
     /// The tables of an `n × n` binary map, row-major (`mask[j·n + i]`, `true` = visible).
     /// Errors: `n` outside the SAT's range or `mask.len() ≠ n²`.
@@ -121,6 +136,58 @@ impl VisMoments {
         self.v.bytes() + self.xv.bytes() + self.yv.bytes()
     }
 
+    /// The borrowed view (all queries live there).
+    pub fn view(&self) -> VisMomentsView<'_> {
+        VisMomentsView {
+            n: self.n,
+            v: self.v.view(),
+            xv: self.xv.view(),
+            yv: self.yv.view(),
+        }
+    }
+
+    /// The three tables `[V, u·V, v·V]` ([`VisMomentsView::tables`]).
+    pub fn tables(&self) -> [SatView<'_>; 3] {
+        [self.v.view(), self.xv.view(), self.yv.view()]
+    }
+
+    /// [`VisMomentsView::moments`].
+    pub fn moments(&self, centre: Vec2, half_diagonal: f32) -> (f32, Vec2) {
+        self.view().moments(centre, half_diagonal)
+    }
+}
+
+impl<'a> VisMomentsView<'a> {
+    /// A view of the tables `V`, `u·V`, `v·V` of one `n × n` map (module docs; e.g. saved
+    /// from a [`VisMoments`] and loaded by the caller). Errors: tables that are not square
+    /// or not all of one size.
+    pub fn new(v: SatView<'a>, xv: SatView<'a>, yv: SatView<'a>) -> Result<Self, Error> {
+        let n = v.width();
+        if [v, xv, yv]
+            .iter()
+            .any(|t| t.width() != n || t.height() != n)
+        {
+            return Err(Error::OutOfRange {
+                what: "visibility moment tables (must be square and of one size)",
+                value: n as f32,
+                min: n as f32,
+                max: n as f32,
+            });
+        }
+        Ok(VisMomentsView { n, v, xv, yv })
+    }
+
+    /// Side of the map.
+    pub fn side(&self) -> usize {
+        self.n
+    }
+
+    /// The three tables `[V, u·V, v·V]` (module docs), for kernels that read them
+    /// directly (the SIMD mirror of [`VisMomentsView::moments`]).
+    pub fn tables(&self) -> [SatView<'a>; 3] {
+        [self.v, self.xv, self.yv]
+    }
+
     /// `(f, m)` of the square with centre `centre` and half-diagonal `half_diagonal` (disk
     /// units): the visible fraction and the mean of `(x − c)·V` over the square (module
     /// docs), `f ∈ [0, 1]`, `|m| ≤ half-side`.
@@ -157,94 +224,104 @@ impl VisMoments {
     /// `(∫V, ∫(x − cu)·V, ∫(y − cv)·V)` over `[a0, a1] × [b0, b1]` (texel units, inside
     /// the table) for the piecewise-constant map, exact up to `f64` rounding and free of
     /// cancellation for boxes of any size: each axis splits into a partly covered first
-    /// texel, a run of whole texels and a partly covered last texel ([`segments`]); each of
-    /// the (up to nine) blocks takes its `∫V` from an exact integer box of the `V` table
-    /// times the covered fractions, and its moment from the partial texel's covered centre
-    /// (`(lo + hi)/2`) or, over a run of whole texels, from the moment table (texel
-    /// centres, exact there).
+    /// texel, a run of whole texels and a partly covered last texel ([`axis_knots`]); each
+    /// of the nine blocks takes its `∫V` from an exact integer box of the `V` table times
+    /// the covered fractions, and its moment from the partial texel's covered centre or,
+    /// over the run of whole texels, from the moment table (texel centres, exact there).
     fn inside(&self, a0: f64, a1: f64, b0: f64, b1: f64, cu: f64, cv: f64) -> (f64, f64, f64) {
         let hn = 0.5 * self.n as f64;
-        let (v, xv, yv) = (self.v.view(), self.xv.view(), self.yv.view());
-        let (qv, qx, qy) = (v.quantum(), xv.quantum(), yv.quantum());
-        let (xs, nx) = segments(a0, a1, self.n);
-        let (ys, ny) = segments(b0, b1, self.n);
-        let (mut s, mut mx, mut my) = (0.0f64, 0.0f64, 0.0f64);
-        for sx in &xs[..nx] {
-            for sy in &ys[..ny] {
-                let bv = v.integer_box(sx.i0, sx.i1, sy.i0, sy.i1) as f64 * qv;
-                let w = sx.w * sy.w;
-                s += w * bv;
-                mx += sy.w
-                    * if sx.partial {
-                        sx.w * bv * (sx.mid - cu)
-                    } else {
-                        xv.integer_box(sx.i0, sx.i1, sy.i0, sy.i1) as f64 * qx - (cu - hn) * bv
-                    };
-                my += sx.w
-                    * if sy.partial {
-                        sy.w * bv * (sy.mid - cv)
-                    } else {
-                        yv.integer_box(sx.i0, sx.i1, sy.i0, sy.i1) as f64 * qy - (cv - hn) * bv
-                    };
-            }
+        let [v, xv, yv] = self.tables();
+        let (kx, ky) = (axis_knots(a0, a1, self.n), axis_knots(b0, b1, self.n));
+        let (x, y) = (kx.knots, ky.knots);
+        let b = |t: &SatView<'_>, q: f64, i: usize, j: usize| {
+            t.integer_box(x[i], x[i + 1], y[j], y[j + 1]) as f64 * q
+        };
+        let bv: [[f64; 3]; 3] =
+            core::array::from_fn(|i| core::array::from_fn(|j| b(&v, v.quantum(), i, j)));
+        let bx: [f64; 3] = core::array::from_fn(|j| b(&xv, xv.quantum(), 1, j));
+        let by: [f64; 3] = core::array::from_fn(|i| b(&yv, yv.quantum(), i, 1));
+        combine_blocks(&kx, &ky, &bv, &bx, &by, cu - hn, cv - hn, cu, cv)
+    }
+}
+
+/// The nine blocks of a query combined (the shared second half of [`VisMoments::moments`]
+/// and its SIMD mirror): `bv[i][j]` the `V` box of x-block `i`, y-block `j` (first, run,
+/// last), `bx[j]` the `u·V` box of the x-run, `by[i]` the `v·V` box of the y-run, `ou =
+/// cu − n/2`, `ov = cv − n/2` (the moment tables' origin seen from the centre).
+#[allow(clippy::too_many_arguments)]
+#[inline(always)]
+fn combine_blocks(
+    kx: &AxisKnots,
+    ky: &AxisKnots,
+    bv: &[[f64; 3]; 3],
+    bx: &[f64; 3],
+    by: &[f64; 3],
+    ou: f64,
+    ov: f64,
+    cu: f64,
+    cv: f64,
+) -> (f64, f64, f64) {
+    let (wx, wy) = (kx.weights(), ky.weights());
+    let (mut s, mut mx, mut my) = (0.0f64, 0.0f64, 0.0f64);
+    for j in 0..3 {
+        for i in 0..3 {
+            s += wx[i] * wy[j] * bv[i][j];
         }
-        (s, mx, my)
+        mx += wy[j]
+            * ((kx.w_first * bv[0][j] * (kx.mid_first - cu) + (bx[j] - ou * bv[1][j]))
+                + kx.w_last * bv[2][j] * (kx.mid_last - cu));
+    }
+    for i in 0..3 {
+        my += wx[i]
+            * ((ky.w_first * bv[i][0] * (ky.mid_first - cv) + (by[i] - ov * bv[i][1]))
+                + ky.w_last * bv[i][2] * (ky.mid_last - cv));
+    }
+    (s, mx, my)
+}
+
+/// One axis `[lo, hi] ⊂ [0, n]` of a query as three blocks of texels: the partly covered
+/// first texel `[X0, X1)`, the run of whole texels `[X1, X2)` and the partly covered last
+/// texel `[X2, X3)` (module docs).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct AxisKnots {
+    /// `X0 ≤ X1 ≤ X2 ≤ X3 ≤ n`.
+    pub knots: [usize; 4],
+    /// Covered length of the first texel (0 when both ends share a texel).
+    pub w_first: f64,
+    /// Covered length of the last texel (the whole `hi − lo` when both ends share it).
+    pub w_last: f64,
+    /// Centre of the covered part of the first texel.
+    pub mid_first: f64,
+    /// Centre of the covered part of the last texel.
+    pub mid_last: f64,
+}
+
+impl AxisKnots {
+    /// The weights of the three blocks, `[w_first, 1, w_last]`.
+    #[inline(always)]
+    pub fn weights(&self) -> [f64; 3] {
+        [self.w_first, 1.0, self.w_last]
     }
 }
 
-/// One piece of a query's extent along an axis: texels `[i0, i1)`, either one partly
-/// covered texel (`partial`: covered fraction `w`, covered centre `mid`) or a run of whole
-/// texels (`w = 1`).
-#[derive(Clone, Copy, Default)]
-struct Segment {
-    i0: usize,
-    i1: usize,
-    partial: bool,
-    w: f64,
-    mid: f64,
-}
-
-/// `[lo, hi] ⊂ [0, n]` as at most three [`Segment`]s: the partial first texel, the whole
-/// texels between, the partial last texel (one partial segment when both ends share a
-/// texel; none when the interval is empty).
-fn segments(lo: f64, hi: f64, n: usize) -> ([Segment; 3], usize) {
-    let mut out = [Segment::default(); 3];
-    if hi <= lo || hi.is_nan() || lo.is_nan() {
-        return (out, 0);
-    }
-    let last = n - 1;
-    let partial = |i: usize, lo: f64, hi: f64| Segment {
-        i0: i,
-        i1: i + 1,
-        partial: true,
-        w: hi - lo,
-        mid: 0.5 * (lo + hi),
-    };
+/// [`AxisKnots`] of `[lo, hi]` for `0 ≤ lo ≤ hi ≤ n` (no NaN): with `c0 = ⌊lo⌋`, `c1 = ⌊hi⌋`
+/// (at most `n − 1`), knots `[c0, min(c0 + 1, c1), c1, c1 + 1]`. When both ends share a
+/// texel the first block and the run are empty and the last block carries `[lo, hi]`.
+#[inline(always)]
+pub fn axis_knots(lo: f64, hi: f64, n: usize) -> AxisKnots {
+    let last = n.saturating_sub(1);
     // `as usize` truncates, which is the floor for `0 ≤ x` (no float floor in no_std).
     let c0 = (lo as usize).min(last);
     let c1 = (hi as usize).min(last);
-    if c0 == c1 {
-        out[0] = partial(c0, lo, hi);
-        return (out, 1);
+    let split = c0 < c1;
+    let start = if split { c1 as f64 } else { lo };
+    AxisKnots {
+        knots: [c0, (c0 + 1).min(c1), c1, c1 + 1],
+        w_first: if split { (c0 + 1) as f64 - lo } else { 0.0 },
+        w_last: hi - start,
+        mid_first: 0.5 * (lo + (c0 + 1) as f64),
+        mid_last: 0.5 * (start + hi),
     }
-    let mut k = 0;
-    out[k] = partial(c0, lo, (c0 + 1) as f64);
-    k += 1;
-    if c1 > c0 + 1 {
-        out[k] = Segment {
-            i0: c0 + 1,
-            i1: c1,
-            partial: false,
-            w: 1.0,
-            mid: 0.0,
-        };
-        k += 1;
-    }
-    if hi > c1 as f64 {
-        out[k] = partial(c1, c1 as f64, hi);
-        k += 1;
-    }
-    (out, k)
 }
 
 #[cfg(test)]
@@ -334,6 +411,40 @@ mod tests {
                 "{c} {r}: my {} vs {by}",
                 m.y
             );
+        }
+    }
+
+    /// The blocks cover `[lo, hi]` exactly: lengths add up, centres are inside, knots
+    /// ordered and in the table (one texel, texel edges, the far edge, empty, `n = 1`).
+    #[test]
+    fn axis_knots_cover_the_interval() {
+        for (lo, hi, n) in [
+            (2.25, 2.75, 8),
+            (2.0, 3.0, 8),
+            (2.5, 7.25, 8),
+            (0.0, 8.0, 8),
+            (7.5, 8.0, 8),
+            (8.0, 8.0, 8),
+            (3.0, 3.0, 8),
+            (0.25, 0.5, 1),
+            (0.0, 1.0, 1),
+        ] {
+            let k = axis_knots(lo, hi, n);
+            let x = k.knots;
+            assert!(
+                x[0] <= x[1] && x[1] <= x[2] && x[2] <= x[3] && x[3] <= n,
+                "{k:?}"
+            );
+            let run = (x[2] - x[1]) as f64;
+            assert_eq!(k.w_first + run + k.w_last, hi - lo, "{lo} {hi}: {k:?}");
+            if k.w_first > 0.0 {
+                assert!(x[1] == x[0] + 1 && (x[0] as f64) <= k.mid_first, "{k:?}");
+                assert!(k.mid_first <= x[1] as f64, "{k:?}");
+            }
+            if k.w_last > 0.0 {
+                assert!(x[3] == x[2] + 1 && (x[2] as f64) <= k.mid_last, "{k:?}");
+                assert!(k.mid_last <= x[3] as f64, "{k:?}");
+            }
         }
     }
 

@@ -42,7 +42,9 @@ use steradian_core::shade::{
 use steradian_core::vdt::Vdt;
 use steradian_core::vis_moments::VisMoments;
 use steradian_core::visibility::{Outside, binary_into, coverage_into, local_cap};
-use steradian_simd::shade::{IsoBrdfTables, ShadeInput, shade_batch};
+use steradian_simd::shade::{
+    IsoBrdfTables, MomentsInput, ShadeInput, shade_batch, shade_moments_batch,
+};
 
 use crate::env::cubemap::for_each_sub_texel;
 use crate::env::{CubeMap, Decomposition};
@@ -718,6 +720,49 @@ pub fn shade_points_simd(
     let inputs = simd_inputs(scene, vdts);
     let mut out = vec![[0.0f32; 3]; inputs.len()];
     shade_batch(&inputs, &tables, query, lights, &mut out).then_some(out)
+}
+
+/// The moments kernel at every point ([`shade::shade_moments`], point `i` with moment
+/// tables `i`), `f32` RGB.
+pub fn shade_points_moments(
+    scene: &Scene,
+    sat: &BrdfSat,
+    moments: &[VisMoments],
+    lights: &[ShadeLight],
+) -> Vec<[f32; 3]> {
+    scene
+        .points
+        .iter()
+        .zip(moments)
+        .map(|(p, m)| shade::shade_moments(&p.frame, p.wo, sat, m, lights))
+        .collect()
+}
+
+/// The SIMD moments kernel at every point (`steradian_simd::shade::shade_moments_batch`).
+/// `None` for an anisotropic BRDF SAT or moment tables of different sizes.
+pub fn shade_points_moments_simd(
+    scene: &Scene,
+    sat: &BrdfSat,
+    moments: &[VisMoments],
+    lights: &[ShadeLight],
+) -> Option<Vec<[f32; 3]>> {
+    let views = iso_views(sat)?;
+    let tables = IsoBrdfTables {
+        tables: &views,
+        s_max: sat.s_max(),
+    };
+    let inputs: Vec<MomentsInput<'_>> = scene
+        .points
+        .iter()
+        .zip(moments)
+        .map(|(p, m)| MomentsInput {
+            frame: p.frame,
+            wo: p.wo,
+            vis: m.view(),
+        })
+        .collect();
+    let mut out = vec![[0.0f32; 3]; inputs.len()];
+    shade_moments_batch(&inputs, &tables, lights, &mut out).then_some(out)
 }
 
 /// The binding-3 table of `wgsl::SHADE` (its layout is documented there), as `f32` bits.

@@ -14,6 +14,7 @@
 use std::sync::OnceLock;
 use std::time::Instant;
 
+use steradian_core::Vec3;
 use steradian_core::brdf::{Brdf, Lambert, Phong};
 use steradian_core::brdf_sat::BrdfSat;
 use steradian_core::shade::{ShadeLight, VdtQuery};
@@ -270,17 +271,20 @@ struct Small {
     scene: Scene,
     sat: BrdfSat,
     vdts: Vec<Vdt>,
+    /// The decomposition's lights, with their radiance gradients.
     lights: Vec<ShadeLight>,
+    /// The same lights without gradients (the paper's uniform squares).
+    uniform_lights: Vec<ShadeLight>,
 }
 
 fn small(glossy: bool) -> Small {
     let cube = env::default_sky(16).unwrap();
     let decs = decompose(&cube, &Options::quiet(&[30])).unwrap();
-    let lights: Vec<ShadeLight> = decs[0]
-        .rsls()
-        .unwrap()
+    let rsls = decs[0].rsls().unwrap();
+    let lights: Vec<ShadeLight> = rsls.iter().map(ShadeLight::from).collect();
+    let uniform_lights: Vec<ShadeLight> = rsls
         .iter()
-        .map(ShadeLight::from)
+        .map(|r| ShadeLight::from(&r.with_gradient([Vec3::ZERO; 3]).unwrap()))
         .collect();
     let brdf: Box<dyn Brdf> = if glossy {
         Box::new(Phong::new(0.3, 0.5, 30.0).unwrap())
@@ -296,6 +300,7 @@ fn small(glossy: bool) -> Small {
         sat,
         vdts,
         lights,
+        uniform_lights,
     }
 }
 
@@ -347,6 +352,82 @@ fn simd_matches_scalar_lane_by_lane() {
             ));
         }
     }
+}
+
+/// The SIMD moments kernel against the scalar one, lane by lane and channel by channel:
+/// Lambert and glossy Phong, lights with their radiance gradients (the decomposition's)
+/// and without, on the standard point set (grazing views, squares across the horizon).
+#[test]
+fn simd_moments_matches_scalar_lane_by_lane() {
+    for glossy in [false, true] {
+        let s = small(glossy);
+        let moments: Vec<_> = sh::par_map(&s.scene.points, |p| sh::point_moments(&s.scene, p, 64));
+        let flat = &s.uniform_lights;
+        assert!(s.lights.iter().any(|l| l.gradient() != [Vec3::ZERO; 3]));
+        for (what, lights) in [("gradient", &s.lights), ("uniform", flat)] {
+            let scalar = sh::shade_points_moments(&s.scene, &s.sat, &moments, lights);
+            let simd = sh::shade_points_moments_simd(&s.scene, &s.sat, &moments, lights).unwrap();
+            let mut worst = 0.0f32;
+            for (p, (a, b)) in scalar.iter().zip(&simd).enumerate() {
+                let m = a.iter().fold(0.0f32, |m, x| m.max(x.abs()));
+                for c in 0..3 {
+                    worst = worst.max((a[c] - b[c]).abs() / m.max(1e-30));
+                }
+                assert!(
+                    close(*a, *b, steradian_simd::shade::MOMENTS_REL_TOL),
+                    "glossy {glossy} {what} point {p}: scalar {a:?} simd {b:?}"
+                );
+            }
+            say(&format!(
+                "SIMD moments vs scalar (glossy {glossy}, {what}): largest relative difference {worst:.2e}"
+            ));
+        }
+    }
+}
+
+/// Bad lanes of the SIMD moments kernel: a NaN view poisons only its lane (NaN, as the
+/// scalar kernel), a view below the horizon gives 0 in its lane, and moment tables of
+/// different sides are refused.
+#[test]
+fn simd_moments_bad_lanes() {
+    use steradian_simd::shade::{IsoBrdfTables, MomentsInput, shade_moments_x8};
+    let s = small(false);
+    let moments: Vec<_> = s.scene.points[..8]
+        .iter()
+        .map(|p| sh::point_moments(&s.scene, p, 32))
+        .collect();
+    let views = sh::iso_views(&s.sat).unwrap();
+    let tables = IsoBrdfTables {
+        tables: &views,
+        s_max: s.sat.s_max(),
+    };
+    let mut pts: [MomentsInput<'_>; 8] = std::array::from_fn(|k| MomentsInput {
+        frame: s.scene.points[k].frame,
+        wo: s.scene.points[k].wo,
+        vis: moments[k].view(),
+    });
+    pts[3].wo = Vec3::new(f32::NAN, 0.0, 1.0);
+    pts[5].wo = -pts[5].frame.normal();
+    let out = shade_moments_x8(&pts, &tables, &s.lights).unwrap();
+    for (k, p) in pts.iter().enumerate() {
+        let want = steradian_core::shade::shade_moments(&p.frame, p.wo, &s.sat, &p.vis, &s.lights);
+        match k {
+            3 => assert!(
+                out[k].iter().chain(&want).all(|x| x.is_nan()),
+                "{:?}",
+                out[k]
+            ),
+            5 => assert_eq!((out[k], want), ([0.0; 3], [0.0; 3])),
+            _ => assert!(
+                close(out[k], want, steradian_simd::shade::MOMENTS_REL_TOL) && want[0] > 0.0,
+                "lane {k}: {:?} vs {want:?}",
+                out[k]
+            ),
+        }
+    }
+    let other = sh::point_moments(&s.scene, &s.scene.points[0], 16);
+    pts[7].vis = other.view();
+    assert!(shade_moments_x8(&pts, &tables, &s.lights).is_none());
 }
 
 #[test]

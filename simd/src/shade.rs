@@ -28,11 +28,17 @@ use steradian_core::frame::Frame;
 use steradian_core::sat::SatView;
 use steradian_core::shade::{ShadeLight, VdtQuery};
 use steradian_core::vdt::{Q_MIN, R_MAX, R_MIN, VdtView};
+use steradian_core::vis_moments::{AxisKnots, VisMomentsView, axis_knots};
 use wide::{f32x8, f64x8, i64x8};
 
 /// Relative difference allowed between [`shade_batch`] and the scalar kernel, per channel,
 /// relative to the point's largest channel (see the module docs).
 pub const REL_TOL: f32 = 2.0e-5;
+
+/// Relative difference allowed between [`shade_moments_batch`] and the scalar moments
+/// kernel, per channel, relative to the point's largest channel (measured by the harness
+/// test `simd_moments_matches_scalar_lane_by_lane`).
+pub const MOMENTS_REL_TOL: f32 = 1.0e-5;
 
 /// An isotropic BRDF SAT as the SIMD kernel reads it: the tables of the polar view nodes
 /// `k = 0..m` (`BrdfSat::table(k, 0)`), all of the same size, and `s_max`, the equal-area
@@ -125,10 +131,24 @@ fn widen(x: f32x8) -> f64x8 {
 fn box_pair(
     tables: &[SatView<'_>],
     views: &[ViewLane; 8],
-    (u0, v0, u1, v1): (f32x8, f32x8, f32x8, f32x8),
+    corners: (f32x8, f32x8, f32x8, f32x8),
     width: usize,
     height: usize,
 ) -> (f32x8, f32x8) {
+    let (a, b) = box_pair_f64(tables, views, corners, width, height);
+    let f = |v: f64x8| f32x8::new(v.to_array().map(|v| v as f32));
+    (f(a), f(b))
+}
+
+/// [`box_pair`] before the rounding to `f32` (`SatView::box_sum_f64` per lane).
+#[inline(always)]
+fn box_pair_f64(
+    tables: &[SatView<'_>],
+    views: &[ViewLane; 8],
+    (u0, v0, u1, v1): (f32x8, f32x8, f32x8, f32x8),
+    width: usize,
+    height: usize,
+) -> (f64x8, f64x8) {
     let (i0, a0, i1, a1) = sat_axis(u0, u1, width);
     let (j0, b0, j1, b1) = sat_axis(v0, v1, height);
     let (i0, i1, j0, j1) = (idx(i0), idx(i1), idx(j0), idx(j1));
@@ -158,7 +178,7 @@ fn box_pair(
         }
     }
     let (a0, a1, b0, b1) = (widen(a0), widen(a1), widen(b0), widen(b1));
-    let one = |gt: &[[i64; 8]; 16], q: [f64; 8]| -> f32x8 {
+    let one = |gt: &[[i64; 8]; 16], q: [f64; 8]| -> f64x8 {
         let row = |r: usize| -> [i64x8; 4] { core::array::from_fn(|c| i64x8::new(gt[4 * r + c])) };
         let (r0, r0p, r1, r1p) = (row(0), row(1), row(2), row(3));
         let x = |l: [i64x8; 4], m: [i64x8; 4]| -> f64x8 {
@@ -168,8 +188,7 @@ fn box_pair(
             (p.round_float() + a1 * e1.round_float()) - a0 * e0.round_float()
         };
         let (xb, xt, xd) = (x(r0, r1), x(r1, r1p), x(r0, r0p));
-        let v = ((xb + b1 * xt) - b0 * xd) * f64x8::new(q);
-        f32x8::new(v.to_array().map(|v| v as f32))
+        ((xb + b1 * xt) - b0 * xd) * f64x8::new(q)
     };
     (one(&g[0], quanta[0]), one(&g[1], quanta[1]))
 }
@@ -259,56 +278,53 @@ fn vdt_lanes(
     }
 }
 
-/// Shades 8 points (lane `k` = `points[k]`), RGB per lane. All VDTs must have the same
-/// square size `n` and the BRDF tables the same size; otherwise (or with fewer than 2
-/// tables) returns `None`.
-pub fn shade_x8(
-    points: &[ShadeInput<'_>; 8],
-    brdf: &IsoBrdfTables<'_>,
-    query: VdtQuery,
-    lights: &[ShadeLight],
-) -> Option<[[f32; 3]; 8]> {
-    let tabs = brdf.tables;
-    let first = tabs.first()?;
-    let (bw, bh) = (first.width(), first.height());
-    if tabs.len() < 2 || tabs.iter().any(|t| t.width() != bw || t.height() != bh) {
-        return None;
+/// The per-lane state both kernels share: the frames as rows, the view's table constants,
+/// the front-facing mask and the NaN poison of each lane.
+struct PointLanes {
+    views: [ViewLane; 8],
+    /// `fr[a][c]`: component `c` of frame axis `a` (tangent, bitangent, normal).
+    fr: [[f32x8; 3]; 3],
+    rot_c: f32x8,
+    rot_s: f32x8,
+    tw: f32x8,
+    front: f32x8,
+    nan: f32x8,
+}
+
+impl PointLanes {
+    fn new(frames: [Frame; 8], wos: [Vec3; 8], brdf: &IsoBrdfTables<'_>) -> PointLanes {
+        let views: [ViewLane; 8] =
+            core::array::from_fn(|k| view_lane(brdf, frames[k].to_local(wos[k])));
+        let lane = |f: &dyn Fn(usize) -> f32| f32x8::new(core::array::from_fn(f));
+        let axes: [Vec3; 3] = [Vec3::X, Vec3::Y, Vec3::Z];
+        // Frame rows: local = (c·t, c·b, c·n).
+        let row = |k: usize, a: usize| -> Vec3 {
+            let f = &frames[k];
+            [f.tangent(), f.bitangent(), f.normal()][a]
+        };
+        PointLanes {
+            views,
+            fr: core::array::from_fn(|a| {
+                core::array::from_fn(|c| lane(&|k| row(k, a).dot(axes[c])))
+            }),
+            rot_c: lane(&|k| views[k].c),
+            rot_s: lane(&|k| views[k].s),
+            tw: lane(&|k| views[k].t),
+            front: lane(&|k| if views[k].front { 1.0 } else { 0.0 }).simd_gt(f32x8::ZERO),
+            // NaN frames or views poison their lane.
+            nan: lane(&|k| {
+                let w = frames[k].to_local(wos[k]);
+                if w.is_nan() { f32::NAN } else { 0.0 }
+            }),
+        }
     }
-    let n = points[0].vdt.width();
-    if points
-        .iter()
-        .any(|p| p.vdt.width() != n || p.vdt.height() != n)
-    {
-        return None;
-    }
-    let views: [ViewLane; 8] =
-        core::array::from_fn(|k| view_lane(brdf, points[k].frame.to_local(points[k].wo)));
-    let lane = |f: &dyn Fn(usize) -> f32| f32x8::new(core::array::from_fn(f));
-    let axes: [Vec3; 3] = [Vec3::X, Vec3::Y, Vec3::Z];
-    // Frame rows: local = (c·t, c·b, c·n).
-    let row = |k: usize, a: usize| -> Vec3 {
-        let f = &points[k].frame;
-        [f.tangent(), f.bitangent(), f.normal()][a]
-    };
-    let fr: [[f32x8; 3]; 3] =
-        core::array::from_fn(|a| core::array::from_fn(|c| lane(&|k| row(k, a).dot(axes[c]))));
-    let rot_c = lane(&|k| views[k].c);
-    let rot_s = lane(&|k| views[k].s);
-    let tw = lane(&|k| views[k].t);
-    let front = lane(&|k| if views[k].front { 1.0 } else { 0.0 }).simd_gt(f32x8::ZERO);
-    // NaN frames or views poison their lane.
-    let nan = lane(&|k| {
-        let p = &points[k];
-        let w = p.frame.to_local(p.wo);
-        if w.is_nan() { f32::NAN } else { 0.0 }
-    });
-    let vdts: [VdtView<'_>; 8] = core::array::from_fn(|k| points[k].vdt);
-    let half_b = f32x8::splat(0.5 * bw as f32);
-    let half_v = f32x8::splat(0.5 * n as f32);
-    let one = f32x8::ONE;
-    let mut acc = [f32x8::ZERO; 3];
-    for l in lights {
-        let c = l.centre();
+
+    /// The centre `(px, py)` of the light's square in each lane's parametrisation (the
+    /// extended equal-area map of the centre turned into the lane's frame) and the mask of
+    /// lanes where it is not wholly below the horizon and the view is in front.
+    #[inline(always)]
+    fn square(&self, c: Vec3, r: f32x8) -> (f32x8, f32x8, f32x8) {
+        let (fr, one) = (&self.fr, f32x8::ONE);
         let x = fr[0][0] * c.x + fr[0][1] * c.y + fr[0][2] * c.z;
         let y = fr[1][0] * c.x + fr[1][1] * c.y + fr[1][2] * c.z;
         let z = fr[2][0] * c.x + fr[2][1] * c.y + fr[2][2] * c.z;
@@ -330,19 +346,79 @@ pub fn shade_x8(
             f32x8::splat(core::f32::consts::SQRT_2),
         );
         let py = y * k;
+        let live = ((px * px + py * py).sqrt() - r).simd_lt(one) & self.front;
+        (px, py, live)
+    }
+
+    /// The square's centre in the BRDF tables' texels (turned by each lane's view azimuth).
+    #[inline(always)]
+    fn brdf_centre(&self, px: f32x8, py: f32x8, half_b: f32x8) -> (f32x8, f32x8) {
+        let one = f32x8::ONE;
+        let qx = px * self.rot_c + py * self.rot_s;
+        let qy = py * self.rot_c - px * self.rot_s;
+        ((qx + one) * half_b, (qy + one) * half_b)
+    }
+
+    /// The accumulated RGB per lane, zero where the view is behind, NaN where poisoned.
+    fn finish(&self, acc: [f32x8; 3]) -> [[f32; 3]; 8] {
+        let acc = acc.map(|a| sel(self.front, a, f32x8::ZERO) + self.nan);
+        let arr = acc.map(|a| a.to_array());
+        core::array::from_fn(|k| [arr[0][k], arr[1][k], arr[2][k]])
+    }
+}
+
+/// The BRDF tables' common size, `None` for fewer than 2 tables or tables of different sizes.
+fn brdf_size(brdf: &IsoBrdfTables<'_>) -> Option<(usize, usize)> {
+    let tabs = brdf.tables;
+    let first = tabs.first()?;
+    let (bw, bh) = (first.width(), first.height());
+    if tabs.len() < 2 || tabs.iter().any(|t| t.width() != bw || t.height() != bh) {
+        return None;
+    }
+    Some((bw, bh))
+}
+
+/// Shades 8 points (lane `k` = `points[k]`), RGB per lane. All VDTs must have the same
+/// square size `n` and the BRDF tables the same size; otherwise (or with fewer than 2
+/// tables) returns `None`.
+pub fn shade_x8(
+    points: &[ShadeInput<'_>; 8],
+    brdf: &IsoBrdfTables<'_>,
+    query: VdtQuery,
+    lights: &[ShadeLight],
+) -> Option<[[f32; 3]; 8]> {
+    let tabs = brdf.tables;
+    let (bw, bh) = brdf_size(brdf)?;
+    let n = points[0].vdt.width();
+    if points
+        .iter()
+        .any(|p| p.vdt.width() != n || p.vdt.height() != n)
+    {
+        return None;
+    }
+    let lanes = PointLanes::new(points.map(|p| p.frame), points.map(|p| p.wo), brdf);
+    let vdts: [VdtView<'_>; 8] = core::array::from_fn(|k| points[k].vdt);
+    let half_b = f32x8::splat(0.5 * bw as f32);
+    let half_v = f32x8::splat(0.5 * n as f32);
+    let one = f32x8::ONE;
+    let mut acc = [f32x8::ZERO; 3];
+    for l in lights {
         let r = f32x8::splat(l.half_diagonal());
-        let live = ((px * px + py * py).sqrt() - r).simd_lt(one) & front;
+        let (px, py, live) = lanes.square(l.centre(), r);
         if !live.any() {
             continue;
         }
         // BRDF: centre rotated by −φₒ, square in table texels.
-        let qx = px * rot_c + py * rot_s;
-        let qy = py * rot_c - px * rot_s;
-        let tcx = (qx + one) * half_b;
-        let tcy = (qy + one) * half_b;
+        let (tcx, tcy) = lanes.brdf_centre(px, py, half_b);
         let h = r * half_b * f32x8::splat(core::f32::consts::FRAC_1_SQRT_2);
-        let (v0, v1) = box_pair(tabs, &views, (tcx - h, tcy - h, tcx + h, tcy + h), bw, bh);
-        let rho = (v0 + tw * (v1 - v0)) * f32x8::splat(l.inv_solid_angle());
+        let (v0, v1) = box_pair(
+            tabs,
+            &lanes.views,
+            (tcx - h, tcy - h, tcx + h, tcy + h),
+            bw,
+            bh,
+        );
+        let rho = (v0 + lanes.tw * (v1 - v0)) * f32x8::splat(l.inv_solid_angle());
         let vis = vdt_lanes(
             &vdts,
             n,
@@ -351,14 +427,289 @@ pub fn shade_x8(
             r * half_v,
             query,
         );
-        let f = sel(live, rho * vis, f32x8::ZERO) + nan;
+        let f = sel(live, rho * vis, f32x8::ZERO) + lanes.nan;
         for (a, e) in acc.iter_mut().zip(l.energy()) {
             *a += f32x8::splat(e) * f;
         }
     }
-    let acc = acc.map(|a| sel(front, a, f32x8::ZERO) + nan);
-    let arr = acc.map(|a| a.to_array());
-    Some(core::array::from_fn(|k| [arr[0][k], arr[1][k], arr[2][k]]))
+    Some(lanes.finish(acc))
+}
+
+/// One shading point of the moments kernel.
+#[derive(Clone, Copy, Debug)]
+pub struct MomentsInput<'a> {
+    /// The local frame.
+    pub frame: Frame,
+    /// Unit view direction (world).
+    pub wo: Vec3,
+    /// The point's visibility moment tables.
+    pub vis: VisMomentsView<'a>,
+}
+
+/// `x` clamped to `[0, hi]` lane-wise; NaN stays NaN (the scalar kernel's clamp).
+#[inline(always)]
+fn clamp_keep_nan(x: f32x8, hi: f32x8) -> f32x8 {
+    sel(
+        x.simd_lt(f32x8::ZERO),
+        f32x8::ZERO,
+        sel(x.simd_gt(hi), hi, x),
+    )
+}
+
+/// `x` clamped to `[lo, hi]` lane-wise in `f64` (`f64::clamp` for non-NaN input).
+#[inline(always)]
+fn clamp64(x: f64x8, lo: f64, hi: f64) -> f64x8 {
+    let (lo, hi) = (f64x8::splat(lo), f64x8::splat(hi));
+    let x = x.simd_lt(lo).select(lo, x);
+    x.simd_gt(hi).select(hi, x)
+}
+
+/// `BrdfSat::integral_gradient` (isotropic) lane-wise: the integral and the gradient of its
+/// density over the square with half-side `h` (texels) around `(tcx, tcy)`.
+#[allow(clippy::too_many_arguments)]
+#[inline(always)]
+fn brdf_gradient(
+    lanes: &PointLanes,
+    tabs: &[SatView<'_>],
+    (tcx, tcy): (f32x8, f32x8),
+    h: f32,
+    half_b: f32,
+    bw: usize,
+    bh: usize,
+) -> (f32x8, [f32x8; 2]) {
+    let hh = f32x8::splat(h);
+    let b = |c| box_pair_f64(tabs, &lanes.views, c, bw, bh);
+    let whole = b((tcx - hh, tcy - hh, tcx + hh, tcy + hh));
+    let right = b((tcx, tcy - hh, tcx + hh, tcy + hh));
+    let top = b((tcx - hh, tcy, tcx + hh, tcy + hh));
+    let two = f64x8::splat(2.0);
+    let parts = |w: f64x8, r: f64x8, t: f64x8| [w, two * r - w, two * t - w];
+    let (p0, p1) = (
+        parts(whole.0, right.0, top.0),
+        parts(whole.1, right.1, top.1),
+    );
+    let t = widen(lanes.tw);
+    let sums: [f64x8; 3] = core::array::from_fn(|i| p0[i] + t * (p1[i] - p0[i]));
+    let to32 = |v: f64x8| f32x8::new(v.to_array().map(|v| v as f32));
+    let hd = f64::from(h) / f64::from(half_b);
+    if hd <= 0.0 {
+        return (to32(sums[0]), [f32x8::ZERO; 2]);
+    }
+    let k = f64x8::splat(1.0 / (2.0 * hd * hd * hd));
+    let (gx, gy) = (sums[1] * k, sums[2] * k);
+    let (c, sn) = (widen(lanes.rot_c), widen(lanes.rot_s));
+    (
+        to32(sums[0]),
+        [to32(c * gx - sn * gy), to32(sn * gx + c * gy)],
+    )
+}
+
+/// `VisMomentsView::moments` lane-wise (each lane its own tables, all of side `n`), for the
+/// square of half-diagonal `r` (disk units, the same in every lane) centred at `(px, py)`:
+/// `(f, m)`. The knots of each lane are `vis_moments::axis_knots`; the 32 table entries a
+/// lane needs are read per lane, the rest is the scalar query's `f64` arithmetic lane-wise.
+#[inline(always)]
+fn vis_moments_lanes(
+    vis: &[VisMomentsView<'_>; 8],
+    n: usize,
+    px: f32x8,
+    py: f32x8,
+    r: f32,
+) -> (f32x8, [f32x8; 2]) {
+    let hn = 0.5 * n as f64;
+    let h = f64::from(steradian_core::sat::square_half_side(r)) * hn;
+    if h <= 0.0 {
+        return (f32x8::ONE, [f32x8::ZERO; 2]);
+    }
+    let (one, half) = (f64x8::splat(1.0), f64x8::splat(0.5));
+    let hn8 = f64x8::splat(hn);
+    let cu = (widen(px) + one) * hn8;
+    let cv = (widen(py) + one) * hn8;
+    let nf = n as f64;
+    let h8 = f64x8::splat(h);
+    let (a0, a1) = (clamp64(cu - h8, 0.0, nf), clamp64(cu + h8, 0.0, nf));
+    let (b0, b1) = (clamp64(cv - h8, 0.0, nf), clamp64(cv + h8, 0.0, nf));
+    let (a0a, a1a, b0a, b1a) = (a0.to_array(), a1.to_array(), b0.to_array(), b1.to_array());
+    let kx: [AxisKnots; 8] = core::array::from_fn(|k| axis_knots(a0a[k], a1a[k], n));
+    let ky: [AxisKnots; 8] = core::array::from_fn(|k| axis_knots(b0a[k], b1a[k], n));
+    // Reads: V at the 4×4 knots, u·V at x-knots 1, 2, v·V at y-knots 1, 2.
+    let mut sv = [[[0i64; 8]; 4]; 4];
+    let mut sx = [[[0i64; 8]; 4]; 2];
+    let mut sy = [[[0i64; 8]; 2]; 4];
+    let mut q = [[0.0f64; 8]; 3];
+    let w1 = n + 1;
+    for k in 0..8 {
+        let [tv, tx, ty] = vis[k].tables();
+        let at =
+            |t: &SatView<'_>, i: usize, j: usize| t.sums().get(j * w1 + i).copied().unwrap_or(0);
+        let (x, y) = (kx[k].knots, ky[k].knots);
+        for (i, &xi) in x.iter().enumerate() {
+            for (j, &yj) in y.iter().enumerate() {
+                sv[i][j][k] = at(&tv, xi, yj);
+            }
+        }
+        for a in 0..2 {
+            for (j, &yj) in y.iter().enumerate() {
+                sx[a][j][k] = at(&tx, x[a + 1], yj);
+            }
+            for (i, &xi) in x.iter().enumerate() {
+                sy[i][a][k] = at(&ty, xi, y[a + 1]);
+            }
+        }
+        q[0][k] = tv.quantum();
+        q[1][k] = tx.quantum();
+        q[2][k] = ty.quantum();
+    }
+    // The integer box between knots [i0, i1] × [j0, j1] of a 2-D grid of reads
+    // (`SatView::integer_box`'s operations), scaled by the quantum.
+    let boxq = |s11: [i64; 8], s01: [i64; 8], s10: [i64; 8], s00: [i64; 8], q: [f64; 8]| {
+        let [s11, s01, s10, s00] = [s11, s01, s10, s00].map(i64x8::new);
+        ((s11 - s01) - (s10 - s00)).round_float() * f64x8::new(q)
+    };
+    let bv: [[f64x8; 3]; 3] = core::array::from_fn(|i| {
+        core::array::from_fn(|j| boxq(sv[i + 1][j + 1], sv[i][j + 1], sv[i + 1][j], sv[i][j], q[0]))
+    });
+    let bx: [f64x8; 3] =
+        core::array::from_fn(|j| boxq(sx[1][j + 1], sx[0][j + 1], sx[1][j], sx[0][j], q[1]));
+    let by: [f64x8; 3] =
+        core::array::from_fn(|i| boxq(sy[i + 1][1], sy[i][1], sy[i + 1][0], sy[i][0], q[2]));
+    let lanes = |ks: &[AxisKnots; 8], f: fn(&AxisKnots) -> f64| {
+        f64x8::new(core::array::from_fn(|k| f(&ks[k])))
+    };
+    let (wfx, wlx) = (lanes(&kx, |a| a.w_first), lanes(&kx, |a| a.w_last));
+    let (mfx, mlx) = (lanes(&kx, |a| a.mid_first), lanes(&kx, |a| a.mid_last));
+    let (wfy, wly) = (lanes(&ky, |a| a.w_first), lanes(&ky, |a| a.w_last));
+    let (mfy, mly) = (lanes(&ky, |a| a.mid_first), lanes(&ky, |a| a.mid_last));
+    let (wx, wy) = ([wfx, one, wlx], [wfy, one, wly]);
+    let (ou, ov) = (cu - hn8, cv - hn8);
+    // `vis_moments::combine_blocks`, lane-wise.
+    let (mut s, mut mx, mut my) = (f64x8::ZERO, f64x8::ZERO, f64x8::ZERO);
+    for j in 0..3 {
+        for i in 0..3 {
+            s += wx[i] * wy[j] * bv[i][j];
+        }
+        mx += wy[j]
+            * ((wfx * bv[0][j] * (mfx - cu) + (bx[j] - ou * bv[1][j]))
+                + wlx * bv[2][j] * (mlx - cu));
+    }
+    for i in 0..3 {
+        my += wx[i]
+            * ((wfy * bv[i][0] * (mfy - cv) + (by[i] - ov * bv[i][1]))
+                + wly * bv[i][2] * (mly - cv));
+    }
+    // `VisMomentsView::moments` after `inside`.
+    let area = f64x8::splat(4.0 * h * h);
+    let area_in = (a1 - a0) * (b1 - b0);
+    let mx_out = -area_in * (half * (a0 + a1) - cu);
+    let my_out = -area_in * (half * (b0 + b1) - cv);
+    let f = clamp64((s + (area - area_in)) / area, 0.0, 1.0);
+    let to_disk = one / (area * hn8);
+    let to32 = |v: f64x8| f32x8::new(v.to_array().map(|v| v as f32));
+    (
+        to32(f),
+        [to32((mx + mx_out) * to_disk), to32((my + my_out) * to_disk)],
+    )
+}
+
+/// The moments kernel (`steradian_core::shade::shade_moments` with an isotropic BRDF SAT and
+/// visibility moment tables per point) for 8 points, RGB per lane. All moment tables must
+/// have the same side and the BRDF tables the same size; otherwise (or with fewer than 2
+/// BRDF tables) returns `None`.
+pub fn shade_moments_x8(
+    points: &[MomentsInput<'_>; 8],
+    brdf: &IsoBrdfTables<'_>,
+    lights: &[ShadeLight],
+) -> Option<[[f32; 3]; 8]> {
+    let tabs = brdf.tables;
+    let (bw, bh) = brdf_size(brdf)?;
+    let n = points[0].vis.side();
+    if points.iter().any(|p| p.vis.side() != n) {
+        return None;
+    }
+    let lanes = PointLanes::new(points.map(|p| p.frame), points.map(|p| p.wo), brdf);
+    let vis: [VisMomentsView<'_>; 8] = points.map(|p| p.vis);
+    let half_b = 0.5 * bw as f32;
+    let mut acc = [f32x8::ZERO; 3];
+    for l in lights {
+        let r = l.half_diagonal();
+        let (px, py, live) = lanes.square(l.centre(), f32x8::splat(r));
+        if !live.any() {
+            continue;
+        }
+        let centre = lanes.brdf_centre(px, py, f32x8::splat(half_b));
+        let h = steradian_core::sat::square_half_side(r) * half_b;
+        let (i, g) = brdf_gradient(&lanes, tabs, centre, h, half_b, bw, bh);
+        let (f, m) = vis_moments_lanes(&vis, n, px, py, r);
+        // `shade::light_moments`, lane-wise.
+        let area = 2.0 * r * r;
+        let joint = i * f + f32x8::splat(area) * (g[0] * m[0] + g[1] * m[1]);
+        let joint = clamp_keep_nan(joint, i) * f32x8::splat(l.inv_solid_angle());
+        let e = l.energy();
+        let mut out: [f32x8; 3] = core::array::from_fn(|c| f32x8::splat(e[c]) * joint);
+        let grad = l.gradient();
+        if grad != [Vec3::ZERO; 3] {
+            let cf = f32x8::splat(area)
+                * f
+                * f32x8::splat(r)
+                * f32x8::splat(r)
+                * f32x8::splat(1.0 / 6.0);
+            let w = [i * m[0] + cf * g[0], i * m[1] + cf * g[1]];
+            // `hemisphere::unmap_jacobian`, lane-wise.
+            let r2 = px * px + py * py;
+            let lim = f32x8::splat(2.0 - 1.0 / 4096.0);
+            let r2 = sel(r2.simd_gt(lim), lim, r2);
+            let sq = (f32x8::splat(2.0) - r2).sqrt();
+            let inv = f32x8::ONE / sq;
+            let uv = px * py * inv;
+            let two = f32x8::splat(2.0);
+            let ju = [sq - px * px * inv, -uv, -(two * px)];
+            let jv = [-uv, sq - py * py * inv, -(two * py)];
+            let loc: [f32x8; 3] = core::array::from_fn(|a| ju[a] * w[0] + jv[a] * w[1]);
+            // Frame::to_world: t·x + b·y + n·z.
+            let fr = &lanes.fr;
+            let u: [f32x8; 3] =
+                core::array::from_fn(|c| fr[0][c] * loc[0] + fr[1][c] * loc[1] + fr[2][c] * loc[2]);
+            for (o, gc) in out.iter_mut().zip(&grad) {
+                let d = f32x8::splat(gc.x) * u[0]
+                    + f32x8::splat(gc.y) * u[1]
+                    + f32x8::splat(gc.z) * u[2];
+                *o = clamp_keep_nan(*o + d, f32x8::splat(f32::INFINITY));
+            }
+        }
+        for (a, o) in acc.iter_mut().zip(out) {
+            *a += sel(live, o, f32x8::ZERO) + lanes.nan;
+        }
+    }
+    Some(lanes.finish(acc))
+}
+
+/// Shades every point with [`shade_moments_x8`] (`out[i]` for `points[i]`), 8 at a time;
+/// the tail is padded with the last point. Returns `false` (leaving `out` untouched) if
+/// the tables do not fit [`shade_moments_x8`]'s requirements or the lengths differ.
+pub fn shade_moments_batch(
+    points: &[MomentsInput<'_>],
+    brdf: &IsoBrdfTables<'_>,
+    lights: &[ShadeLight],
+    out: &mut [[f32; 3]],
+) -> bool {
+    if points.len() != out.len() {
+        return false;
+    }
+    let Some(last) = points.last() else {
+        return true;
+    };
+    let mut i = 0;
+    while i < points.len() {
+        let group: [MomentsInput<'_>; 8] =
+            core::array::from_fn(|k| *points.get(i + k).unwrap_or(last));
+        let Some(r) = shade_moments_x8(&group, brdf, lights) else {
+            return false;
+        };
+        let m = (points.len() - i).min(8);
+        out[i..i + m].copy_from_slice(&r[..m]);
+        i += 8;
+    }
+    true
 }
 
 /// Shades every point (`out[i]` for `points[i]`), 8 at a time; the tail is padded with the
