@@ -1,7 +1,7 @@
 //! RSL shading (`steradian_core::shade`): scalar vs SIMD (8 points per call) over the same
 //! points × K lights, for a diffuse and a glossy BRDF SAT, and the scalar moments kernel
-//! (`shade_moments`: linear BRDF, linear light, visibility moments) beside them. Throughput
-//! is in RSL evaluations (points × K) per second.
+//! (`shade_moments`: linear BRDF, linear light, visibility moments) and its SIMD twin beside
+//! them. Throughput is in RSL evaluations (points × K) per second.
 //!
 //! `cargo bench -p steradian-benches --bench shade`
 
@@ -12,7 +12,7 @@ use steradian_core::brdf::{Brdf, Lambert, Phong};
 use steradian_core::shade::{self, ShadeLight, VdtQuery, VdtVisibility};
 use steradian_harness::env::{self, decompose};
 use steradian_harness::shade::{self as sh, Scene};
-use steradian_simd::shade::{IsoBrdfTables, shade_batch};
+use steradian_simd::shade::{IsoBrdfTables, MomentsInput, shade_batch, shade_moments_batch};
 
 fn bench(c: &mut Criterion) {
     let cube = env::default_sky(32).unwrap();
@@ -36,6 +36,16 @@ fn bench(c: &mut Criterion) {
             s_max: sat.s_max(),
         };
         let inputs = sh::simd_inputs(&scene, &vdts);
+        let minputs: Vec<MomentsInput<'_>> = scene
+            .points
+            .iter()
+            .zip(&moments)
+            .map(|(p, m)| MomentsInput {
+                frame: p.frame,
+                wo: p.wo,
+                vis: m.view(),
+            })
+            .collect();
         for d in &decs {
             let lights: Vec<ShadeLight> = d.rsls().unwrap().iter().map(ShadeLight::from).collect();
             g.throughput(Throughput::Elements(
@@ -61,6 +71,12 @@ fn bench(c: &mut Criterion) {
                 })
             });
             let mut out = vec![[0.0f32; 3]; inputs.len()];
+            g.bench_function(format!("{mname}/K{}/moments_simd", d.k), |b| {
+                b.iter(|| {
+                    shade_moments_batch(&minputs, &tables, black_box(&lights), &mut out);
+                    out[0][1]
+                })
+            });
             g.bench_function(format!("{mname}/K{}/simd", d.k), |b| {
                 b.iter(|| {
                     shade_batch(

@@ -114,9 +114,16 @@ fn time(min: Duration, mut f: impl FnMut()) -> f64 {
     ts[ts.len() / 2]
 }
 
-/// Scalar and SIMD RSL evaluations/s, wgpu's (or why not), points, lights.
-/// Scalar, SIMD, wgpu, scalar moments kernel (RSL evaluations/s), points, lights.
-type Throughput = (f64, f64, Result<f64, String>, f64, usize, usize);
+/// RSL evaluations/s of each backend (wgpu's, or why not), and the workload.
+struct Throughput {
+    scalar: f64,
+    simd: f64,
+    gpu: Result<f64, String>,
+    moments: f64,
+    moments_simd: f64,
+    points: usize,
+    lights: usize,
+}
 
 /// Throughput in RSL evaluations per second: scalar, SIMD, wgpu (or why not).
 fn throughput(opts: &Options) -> Result<Throughput, Box<dyn Error>> {
@@ -147,6 +154,14 @@ fn throughput(opts: &Options) -> Result<Throughput, Box<dyn Error>> {
                 black_box(&lights),
             ));
         }
+    });
+    let t_moments_simd = time(Duration::from_millis(400), || {
+        black_box(sh::shade_points_moments_simd(
+            &scene,
+            &sat,
+            &moments,
+            black_box(&lights),
+        ));
     });
     let t_simd = time(Duration::from_millis(400), || {
         black_box(sh::shade_points_simd(
@@ -194,14 +209,15 @@ fn throughput(opts: &Options) -> Result<Throughput, Box<dyn Error>> {
             }
         }
     };
-    Ok((
-        evals / t_scalar,
-        evals / t_simd,
+    Ok(Throughput {
+        scalar: evals / t_scalar,
+        simd: evals / t_simd,
         gpu,
-        evals / t_moments,
-        scene.points.len(),
-        lights.len(),
-    ))
+        moments: evals / t_moments,
+        moments_simd: evals / t_moments_simd,
+        points: scene.points.len(),
+        lights: lights.len(),
+    })
 }
 
 /// The report section.
@@ -220,7 +236,15 @@ pub fn section(opts: &Options) -> Result<Section, Box<dyn Error>> {
     )?;
     bar.inc(1);
     bar.set_message("throughput");
-    let (scalar, simd, gpu, moments, np, nk) = throughput(opts)?;
+    let Throughput {
+        scalar,
+        simd,
+        gpu,
+        moments,
+        moments_simd,
+        points: np,
+        lights: nk,
+    } = throughput(opts)?;
     bar.inc(1);
     bar.finish_and_clear();
 
@@ -301,7 +325,8 @@ pub fn section(opts: &Options) -> Result<Section, Box<dyn Error>> {
          <tr><td>scalar</td><td>{:.1} M/s</td><td>1</td><td>{:.2}</td></tr>\
          <tr><td>SIMD (8 points per call)</td><td>{:.1} M/s</td><td>{:.2}</td><td>{:.2}</td></tr>\
          <tr><td>wgpu</td><td>{gpu_s}</td><td>{}</td><td>{}</td></tr>\
-         <tr><td>moments kernel, scalar (64² moment tables)</td><td>{:.1} M/s</td><td>{:.2}</td><td>{:.2}</td></tr></table>",
+         <tr><td>moments kernel, scalar (64² moment tables)</td><td>{:.1} M/s</td><td>{:.2}</td><td>{:.2}</td></tr>\
+         <tr><td>moments kernel, SIMD (8 points per call)</td><td>{:.1} M/s</td><td>{:.2}</td><td>{:.2}</td></tr></table>",
         scalar / 1e6,
         scalar / PAPER_EVALS_PER_S,
         simd / 1e6,
@@ -314,15 +339,20 @@ pub fn section(opts: &Options) -> Result<Section, Box<dyn Error>> {
         moments / 1e6,
         moments / scalar,
         moments / PAPER_EVALS_PER_S,
+        moments_simd / 1e6,
+        moments_simd / scalar,
+        moments_simd / PAPER_EVALS_PER_S,
     );
     let _ = writeln!(
         summary,
-        "shade throughput (RSL evals/s): scalar {:.1} M, SIMD {:.1} M ({:.2}× scalar), wgpu {gpu_s}, moments kernel scalar {:.1} M ({:.2}× scalar); paper 19.4 M",
+        "shade throughput (RSL evals/s): scalar {:.1} M, SIMD {:.1} M ({:.2}× scalar), wgpu {gpu_s}, moments kernel scalar {:.1} M ({:.2}× scalar), SIMD {:.1} M ({:.2}× its scalar); paper 19.4 M",
         scalar / 1e6,
         simd / 1e6,
         simd / scalar,
         moments / 1e6,
-        moments / scalar
+        moments / scalar,
+        moments_simd / 1e6,
+        moments_simd / moments,
     );
     let env_json = |e: &EnvResult| {
         json!({
@@ -348,6 +378,7 @@ pub fn section(opts: &Options) -> Result<Section, Box<dyn Error>> {
             "paper": PAPER.iter().map(|p| json!({"k": p.0, "fig9": p.1, "fig10": p.2})).collect::<Vec<_>>(),
             "throughput": {
                 "scalar": scalar, "simd": simd, "moments_scalar": moments,
+                "moments_simd": moments_simd,
                 "gpu": gpu.as_ref().ok(),
                 "paper": PAPER_EVALS_PER_S,
                 "points": np, "k": nk,
