@@ -17,8 +17,9 @@
 //! ```
 //!
 //! exact for a linear `φ` and any visibility. `f` and `m` are box sums of `V`, `u·V` and
-//! `v·V`: three summed-area tables ([`crate::sat`], exact `i64` fixed point), 48 lookups
-//! (four knots per corner and table).
+//! `v·V`: three summed-area tables ([`crate::sat`], exact `i64` fixed point). A query
+//! reads 32 distinct entries: `V` at the 4 × 4 knots of its box ([`axis_knots`]), the
+//! moment tables at 8 each.
 //!
 //! ## Grid, units, accuracy
 //!
