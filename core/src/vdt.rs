@@ -34,7 +34,7 @@
 //! minimum over every boundary edge, computed in `f64` the same way). The nearest point
 //! of `B` to a texel centre is a lattice corner on `B` or the midpoint of a boundary edge in
 //! the texel's own row or column; the distance transform of Felzenszwalb and Huttenlocher
-//! (2012, the paper's reference [4]) runs over the corners in doubled integer coordinates
+//! (2012, the paper's reference \[4\]) runs over the corners in doubled integer coordinates
 //! (a nearest-site sweep along `v`, then the lower envelope of parabolas along `u`), and two
 //! 1-D sweeps give the row and column runs. All squared distances are integers (exact in
 //! `f64`); the time is linear in the number of texels. (The rounding of an envelope
