@@ -48,7 +48,7 @@
 
 use alloc::vec::Vec;
 
-use crate::sat::Sat;
+use crate::sat::{Sat, SatView};
 use crate::{Error, Vec2};
 
 /// Three exact summed-area tables of a visibility map: `V`, `u·V`, `v·V` (module docs).
@@ -119,6 +119,14 @@ impl VisMoments {
     /// Bytes of the three tables.
     pub fn bytes(&self) -> usize {
         self.v.bytes() + self.xv.bytes() + self.yv.bytes()
+    }
+
+    /// The three summed-area tables `[V, (i + ½ − n/2)·V, (j + ½ − n/2)·V]` (module docs;
+    /// texel-unit offsets from the table's centre), each `n × n` with its own quantum, for
+    /// kernels that read them directly (the WGSL moments kernel, `wgsl::SHADE_MOMENTS`,
+    /// uploads their entries).
+    pub fn tables(&self) -> [SatView<'_>; 3] {
+        [self.v.view(), self.xv.view(), self.yv.view()]
     }
 
     /// `(f, m)` of the square with centre `centre` and half-diagonal `half_diagonal` (disk
