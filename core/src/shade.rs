@@ -77,8 +77,8 @@
 //! holds for both), against 0.26 % and 0.28 % for the exact integral of the same linear
 //! lights over the same squares, and 0.51 % / 0.29 % for the paper's uniform squares.
 //! Cost: 0.24–0.42× the eq. 5 kernel's scalar speed (report runs on the dev machine),
-//! and three `(n + 1)²` `i64` tables per point instead of one `n²` `f32` VDT. Scalar only
-//! for now (no SIMD or WGSL mirror).
+//! and three `(n + 1)²` `i64` tables per point instead of one `n²` `f32` VDT. No SIMD
+//! mirror yet; the WGSL one is [`crate::wgsl::SHADE_MOMENTS`].
 //!
 //! ## Eq. 13 (section 6.1)
 //!

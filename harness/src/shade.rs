@@ -820,7 +820,10 @@ pub fn shade_points_moments(
 fn gpu_moments_words(grid: usize, polar: usize, lights: usize, vis_n: usize) -> (usize, usize) {
     let brdf = (1 + 2 * (grid + 1) * (grid + 1)) * polar;
     let point = 3 * (1 + 2 * (vis_n + 1) * (vis_n + 1));
-    (GPU_MOMENTS_HEADER + GPU_MOMENTS_LIGHT_WORDS * lights + brdf, point)
+    (
+        GPU_MOMENTS_HEADER + GPU_MOMENTS_LIGHT_WORDS * lights + brdf,
+        point,
+    )
 }
 
 /// Header words of `wgsl::SHADE_MOMENTS`'s table.
@@ -909,8 +912,7 @@ pub fn shade_points_moments_gpu(
     }
     let polar = iso_views(sat).map_or(0, |v| v.len());
     let vn = moments.first().map_or(1, VisMoments::side);
-    let (fixed, per_point) =
-        gpu_moments_words(sat.resolution().grid, polar, lights.len(), vn);
+    let (fixed, per_point) = gpu_moments_words(sat.resolution().grid, polar, lights.len(), vn);
     let chunk = (max_table_bytes / 4).saturating_sub(fixed) / per_point;
     let chunk = chunk.max(1);
     let mut out = Vec::with_capacity(moments.len());
