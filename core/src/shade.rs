@@ -79,7 +79,7 @@
 //! Cost: 0.21–0.42× the eq. 5 kernel's scalar speed (report runs on the dev machine),
 //! and three `(n + 1)²` `i64` tables per point instead of one `n²` `f32` VDT. The SIMD
 //! twin (`steradian_simd::shade::shade_moments_batch`, tested lane by lane) runs at about
-//! 4.7× this scalar kernel; there is no WGSL twin yet.
+//! 4.7× this scalar kernel; the WGSL twin is [`crate::wgsl::SHADE_MOMENTS`].
 //!
 //! ## Eq. 13 (section 6.1)
 //!

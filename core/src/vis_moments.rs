@@ -147,7 +147,10 @@ impl VisMoments {
         }
     }
 
-    /// The three tables `[V, u·V, v·V]` ([`VisMomentsView::tables`]).
+    /// The three summed-area tables `[V, (i + ½ − n/2)·V, (j + ½ − n/2)·V]` (module docs;
+    /// texel-unit offsets from the table's centre), each `n × n` with its own quantum, for
+    /// kernels that read them directly (the WGSL moments kernel, `wgsl::SHADE_MOMENTS`,
+    /// uploads their entries; [`VisMomentsView::tables`]).
     pub fn tables(&self) -> [SatView<'_>; 3] {
         [self.v.view(), self.xv.view(), self.yv.view()]
     }

@@ -170,6 +170,50 @@ pub const SHADE: &str = concat!(
 /// its half-side).
 pub const SHADE_REL_TOL: f32 = 1.0e-4;
 
+/// RSL shading with visibility moments, one point per invocation
+/// (`shade::shade_moments` with an isotropic BRDF SAT and one `vis_moments::VisMoments`
+/// per point). Input columns `[tx, ty, tz, bx, by, bz, nx, ny, nz, wox, woy, woz,
+/// point_index]` (frame axes, world view, which point's tables), output `[r, g, b]`.
+/// Binding 3 is one **`array<u32>`** table (a caller with an `f32` binding passes the same
+/// bits):
+///
+/// - header `[lights, grid, polar, s_max (f32 bits), vis_n, off_lights, off_brdf,
+///   off_vis]`;
+/// - per light 17 `f32` words `[cx, cy, cz, r, 1/Ω, E_r, E_g, E_b, G_r (3), G_g (3),
+///   G_b (3)]` (`shade::ShadeLight`, the radiance gradients last);
+/// - per BRDF table (polar node `k`) its exponent word and its `(grid + 1)²` `i64` entries
+///   as `(low, high)` word pairs, as in `sat::SatView::gpu_words` (as [`SHADE`]);
+/// - per point the three tables of `VisMoments::tables` (`V`, `u·V`, `v·V`, each `vis_n`
+///   wide), each as its exponent word and its `(vis_n + 1)²` entries in the same pairs:
+///   `3·(1 + 2·(vis_n + 1)²)` words per point, 1.6 MB at `vis_n = 256`.
+///
+/// The harness's `shade::gpu_moments_table` builds it (and splits large batches so that
+/// each table stays within the device's storage-binding limit). Same formulas as the scalar
+/// kernel; the visibility moments are exact for the piecewise-constant map as there (the
+/// partly covered edge texels weighted at their covered centres), from exact 64-bit
+/// integer box sums: the square's edges are placed relative to an integer texel near its
+/// centre (so they keep the precision of the square's size, not of the table's), and a
+/// run of whole texels takes its moment `M − (c − n/2)·V` — two terms that grow with the
+/// distance from the table's centre — as the exact integer `M − s·(V ≫ k)` (`s` the
+/// integer part of `c − n/2`, `2^k` the ratio of the two tables' quanta) plus `f32`
+/// remainders below a quantum of `M` and `frac·V`. Sums are then combined in `f32`
+/// (not `f64`), the BRDF box sums as in [`SAT_BOX`]. Tolerance: [`SHADE_MOMENTS_REL_TOL`].
+pub const SHADE_MOMENTS: &str = concat!(
+    include_str!("wgsl/batch.wgsl"),
+    include_str!("wgsl/sat_lib.wgsl"),
+    include_str!("wgsl/shade_moments.wgsl")
+);
+/// Difference allowed between [`SHADE_MOMENTS`] and `shade::shade_moments`, per channel,
+/// relative to the point's largest channel. Lavapipe (harness test
+/// `tests/shade_moments_gpu.rs`, 111 points with 256² maps, K = 30 lights with radiance
+/// gradients, grazing views and squares across the horizon): `2.2e-6` (Lambert) and
+/// `1.1e-6` (Phong), about what [`SHADE`] measures, from the `f32` BRDF box sums and the
+/// map's last ulps; the visibility moments alone differ by `1.2e-6` in `f` and `5.7e-7·h`
+/// in `m` (`1.4e-6·h` when a run's moment is taken as the plain `f32` difference). Kept
+/// tight on purpose: dropping the kernel's `g·m` term moves the result by only about
+/// `1e-4` of it.
+pub const SHADE_MOMENTS_REL_TOL: f32 = 1.0e-5;
+
 /// Product of two cosine lobes as one lobe (`product::product_with` with
 /// `ProductFit::ExactIntegral`, the only fit on the GPU). Input columns
 /// `[a1x, a1y, a1z, s1, e1, a2x, a2y, a2z, s2, e2]` (unit axes, as `CosineLobe` stores
@@ -213,11 +257,12 @@ pub const ALL: [(&str, &str); 5] = [
 
 /// The kernels outside [`ALL`], with a caller-supplied table at binding 3 (run them with
 /// the harness's custom kernels), as `(name, source, element type of the table)`.
-pub const CUSTOM: [(&str, &str, &str); 4] = [
+pub const CUSTOM: [(&str, &str, &str); 5] = [
     ("lobe-product", LOBE_PRODUCT, "f32"),
     ("sat-box", SAT_BOX, "u32"),
     ("vdt-query", VDT_QUERY, "f32"),
     ("shade", SHADE, "u32"),
+    ("shade-moments", SHADE_MOMENTS, "u32"),
 ];
 
 /// Per-component absolute difference allowed between [`HEMISPHERE_MAP`] and

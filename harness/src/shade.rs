@@ -824,8 +824,13 @@ pub fn gpu_table(
 
 /// The input columns of `wgsl::SHADE` for every point (point `i` uses VDT `i`).
 pub fn gpu_input(scene: &Scene) -> crate::kernels::Columns {
-    let rows: Vec<[f32; 13]> = scene
-        .points
+    gpu_input_points(&scene.points)
+}
+
+/// The input columns of `wgsl::SHADE` and `wgsl::SHADE_MOMENTS` for `points` (point `i`
+/// of the slice uses table `i` of the kernel's table).
+pub fn gpu_input_points(points: &[ShadePoint]) -> crate::kernels::Columns {
+    let rows: Vec<[f32; 13]> = points
         .iter()
         .enumerate()
         .map(|(i, p)| {
@@ -836,4 +841,124 @@ pub fn gpu_input(scene: &Scene) -> crate::kernels::Columns {
         })
         .collect();
     crate::kernels::Columns::from_rows(&rows)
+}
+
+/// Words of `wgsl::SHADE_MOMENTS`'s table before the per-point tables (header, lights and
+/// BRDF tables), and the words per point, for a BRDF SAT with `polar` tables of side
+/// `grid`, `lights` lights and maps of side `vis_n`.
+fn gpu_moments_words(grid: usize, polar: usize, lights: usize, vis_n: usize) -> (usize, usize) {
+    let brdf = (1 + 2 * (grid + 1) * (grid + 1)) * polar;
+    let point = 3 * (1 + 2 * (vis_n + 1) * (vis_n + 1));
+    (
+        GPU_MOMENTS_HEADER + GPU_MOMENTS_LIGHT_WORDS * lights + brdf,
+        point,
+    )
+}
+
+/// Header words of `wgsl::SHADE_MOMENTS`'s table.
+const GPU_MOMENTS_HEADER: usize = 8;
+/// Words per light of `wgsl::SHADE_MOMENTS`'s table.
+const GPU_MOMENTS_LIGHT_WORDS: usize = 17;
+
+/// The binding-3 table of `wgsl::SHADE_MOMENTS` (its layout is documented there), as `f32`
+/// bits, for the points whose moment tables are `moments` (the kernel's point index `i`
+/// reads `moments[i]`). `None` for an anisotropic BRDF SAT or maps of different sizes.
+/// 1.6 MB per point at `n = 256`: [`shade_points_moments_gpu`] splits a batch so that each
+/// table stays within a byte limit.
+pub fn gpu_moments_table(
+    sat: &BrdfSat,
+    moments: &[&VisMoments],
+    lights: &[ShadeLight],
+) -> Option<Vec<f32>> {
+    let views = iso_views(sat)?;
+    let grid = sat.resolution().grid;
+    let vn = moments.first().map_or(1, |m| m.side());
+    if moments.iter().any(|m| m.side() != vn) {
+        return None;
+    }
+    let (fixed, per_point) = gpu_moments_words(grid, views.len(), lights.len(), vn);
+    let off_brdf = GPU_MOMENTS_HEADER + GPU_MOMENTS_LIGHT_WORDS * lights.len();
+    let mut w: Vec<u32> = Vec::with_capacity(fixed + per_point * moments.len());
+    w.extend([
+        lights.len() as u32,
+        grid as u32,
+        views.len() as u32,
+        sat.s_max().to_bits(),
+        vn as u32,
+        GPU_MOMENTS_HEADER as u32,
+        off_brdf as u32,
+        fixed as u32,
+    ]);
+    for l in lights {
+        let (c, e, g) = (l.centre(), l.energy(), l.gradient());
+        let mut words = vec![c.x, c.y, c.z, l.half_diagonal(), l.inv_solid_angle()];
+        words.extend(e);
+        words.extend(g.iter().flat_map(|v| v.to_array()));
+        w.extend(words.into_iter().map(f32::to_bits));
+    }
+    let sat_words = |w: &mut Vec<u32>, v: &steradian_core::sat::SatView<'_>| {
+        w.push(v.exponent() as u32);
+        // `gpu_words` = 4 header words, then the entries.
+        w.extend(v.gpu_words().skip(steradian_core::sat::GPU_HEADER_WORDS));
+    };
+    for v in &views {
+        sat_words(&mut w, v);
+    }
+    debug_assert_eq!(w.len(), fixed);
+    for m in moments {
+        for t in &m.tables() {
+            sat_words(&mut w, t);
+        }
+    }
+    debug_assert_eq!(w.len(), fixed + per_point * moments.len());
+    Some(w.into_iter().map(f32::from_bits).collect())
+}
+
+/// wgpu's default `max_storage_buffer_binding_size` (128 MiB): the largest table
+/// [`shade_points_moments_gpu`] uploads at once unless told otherwise.
+pub const GPU_MOMENTS_MAX_TABLE_BYTES: usize = 128 << 20;
+
+/// `wgsl::SHADE_MOMENTS` at every point (point `i` with `moments[i]`) on the GPU backend,
+/// `f32` RGB: the points are split into consecutive chunks whose tables
+/// ([`gpu_moments_table`]) stay within `max_table_bytes` (at least one point per chunk),
+/// one dispatch per chunk. `Err` for an anisotropic BRDF SAT, maps of different sizes,
+/// a count mismatch or a device error.
+pub fn shade_points_moments_gpu(
+    gpu: &mut crate::backend::gpu::Gpu,
+    scene: &Scene,
+    sat: &BrdfSat,
+    moments: &[VisMoments],
+    lights: &[ShadeLight],
+    max_table_bytes: usize,
+) -> Result<Vec<[f32; 3]>, crate::backend::BackendError> {
+    use crate::backend::BackendError;
+    if moments.len() != scene.points.len() {
+        return Err(BackendError(format!(
+            "shade-moments: {} points, {} moment tables",
+            scene.points.len(),
+            moments.len()
+        )));
+    }
+    let polar = iso_views(sat).map_or(0, |v| v.len());
+    let vn = moments.first().map_or(1, VisMoments::side);
+    let (fixed, per_point) = gpu_moments_words(sat.resolution().grid, polar, lights.len(), vn);
+    let chunk = (max_table_bytes / 4).saturating_sub(fixed) / per_point;
+    let chunk = chunk.max(1);
+    let mut out = Vec::with_capacity(moments.len());
+    for (points, ms) in scene.points.chunks(chunk).zip(moments.chunks(chunk)) {
+        let refs: Vec<&VisMoments> = ms.iter().collect();
+        let table = gpu_moments_table(sat, &refs, lights).ok_or_else(|| {
+            BackendError("shade-moments: anisotropic BRDF SAT or maps of different sizes".into())
+        })?;
+        let input = gpu_input_points(points);
+        let mut cols = crate::kernels::Columns::zeros(3, input.n);
+        let custom = crate::backend::gpu::Custom {
+            label: "rsl-shade-moments",
+            source: steradian_core::wgsl::SHADE_MOMENTS,
+            table: Some(&table),
+        };
+        gpu.run_custom(&custom, &input, &mut cols)?;
+        out.extend((0..input.n).map(|p| [0, 1, 2].map(|c| cols.data[c * input.n + p])));
+    }
+    Ok(out)
 }
