@@ -162,6 +162,7 @@ pub const SHADE: &str = concat!(
     include_str!("wgsl/batch.wgsl"),
     include_str!("wgsl/sat_lib.wgsl"),
     include_str!("wgsl/vdt_lib.wgsl"),
+    include_str!("wgsl/shade_lib.wgsl"),
     include_str!("wgsl/shade.wgsl")
 );
 /// Difference allowed between [`SHADE`] and `shade::shade`, per channel, relative to the
@@ -201,6 +202,7 @@ pub const SHADE_REL_TOL: f32 = 1.0e-4;
 pub const SHADE_MOMENTS: &str = concat!(
     include_str!("wgsl/batch.wgsl"),
     include_str!("wgsl/sat_lib.wgsl"),
+    include_str!("wgsl/shade_lib.wgsl"),
     include_str!("wgsl/shade_moments.wgsl")
 );
 /// Difference allowed between [`SHADE_MOMENTS`] and `shade::shade_moments`, per channel,

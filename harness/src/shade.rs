@@ -765,6 +765,62 @@ pub fn shade_points_moments_simd(
     shade_moments_batch(&inputs, &tables, lights, &mut out).then_some(out)
 }
 
+/// The part of the binding-3 tables of `wgsl::SHADE` and `wgsl::SHADE_MOMENTS` before
+/// their per-point maps (shade_lib.wgsl): the header `[lights, grid, polar, s_max, map_n,
+/// off_lights, off_brdf, off_maps]` followed by `extra` header words, per light `[cx, cy,
+/// cz, r, 1/Ω, E_r, E_g, E_b]` (and its three gradients if `gradients`), then every BRDF
+/// table as its exponent word and entries ([`push_sat_words`]).
+fn gpu_shade_prefix(
+    sat: &BrdfSat,
+    views: &[steradian_core::sat::SatView<'_>],
+    lights: &[ShadeLight],
+    gradients: bool,
+    map_n: usize,
+    extra: &[u32],
+) -> Vec<u32> {
+    let grid = sat.resolution().grid;
+    let header = GPU_SHADE_HEADER + extra.len();
+    let light_words = if gradients {
+        GPU_MOMENTS_LIGHT_WORDS
+    } else {
+        GPU_SHADE_LIGHT_WORDS
+    };
+    let off_brdf = header + light_words * lights.len();
+    let off_maps = off_brdf + (1 + 2 * (grid + 1) * (grid + 1)) * views.len();
+    let mut w: Vec<u32> = vec![
+        lights.len() as u32,
+        grid as u32,
+        views.len() as u32,
+        sat.s_max().to_bits(),
+        map_n as u32,
+        header as u32,
+        off_brdf as u32,
+        off_maps as u32,
+    ];
+    w.extend(extra);
+    for l in lights {
+        let (c, e) = (l.centre(), l.energy());
+        let mut words = vec![c.x, c.y, c.z, l.half_diagonal(), l.inv_solid_angle()];
+        words.extend(e);
+        if gradients {
+            words.extend(l.gradient().iter().flat_map(|v| v.to_array()));
+        }
+        w.extend(words.into_iter().map(f32::to_bits));
+    }
+    for v in views {
+        push_sat_words(&mut w, v);
+    }
+    debug_assert_eq!(w.len(), off_maps);
+    w
+}
+
+/// A summed-area table as the shading kernels read it: its exponent word, then its entries
+/// as `(low, high)` word pairs (`SatView::gpu_words` after its header).
+fn push_sat_words(w: &mut Vec<u32>, v: &steradian_core::sat::SatView<'_>) {
+    w.push(v.exponent() as u32);
+    w.extend(v.gpu_words().skip(steradian_core::sat::GPU_HEADER_WORDS));
+}
+
 /// The binding-3 table of `wgsl::SHADE` (its layout is documented there), as `f32` bits.
 /// `None` for an anisotropic BRDF SAT or VDTs of different sizes.
 pub fn gpu_table(
@@ -774,48 +830,18 @@ pub fn gpu_table(
     query: VdtQuery,
 ) -> Option<Vec<f32>> {
     let views = iso_views(sat)?;
-    let grid = sat.resolution().grid;
     let vn = vdts.first().map_or(1, |v| v.width());
     if vdts.iter().any(|v| v.width() != vn || v.height() != vn) {
         return None;
     }
-    const HEADER: usize = 9;
-    let off_lights = HEADER;
-    let off_brdf = off_lights + 8 * lights.len();
-    let stride = 1 + 2 * (grid + 1) * (grid + 1);
-    let off_vdt = off_brdf + stride * views.len();
-    let mut w: Vec<u32> = vec![
-        lights.len() as u32,
-        grid as u32,
-        views.len() as u32,
-        sat.s_max().to_bits(),
-        vn as u32,
-        off_lights as u32,
-        off_brdf as u32,
-        off_vdt as u32,
-        (query == VdtQuery::Gradient) as u32,
-    ];
-    for l in lights {
-        let (c, e) = (l.centre(), l.energy());
-        w.extend(
-            [
-                c.x,
-                c.y,
-                c.z,
-                l.half_diagonal(),
-                l.inv_solid_angle(),
-                e[0],
-                e[1],
-                e[2],
-            ]
-            .map(f32::to_bits),
-        );
-    }
-    for v in &views {
-        w.push(v.exponent() as u32);
-        // `gpu_words` = 4 header words, then the entries.
-        w.extend(v.gpu_words().skip(steradian_core::sat::GPU_HEADER_WORDS));
-    }
+    let mut w = gpu_shade_prefix(
+        sat,
+        &views,
+        lights,
+        false,
+        vn,
+        &[(query == VdtQuery::Gradient) as u32],
+    );
     for v in vdts {
         w.extend(v.samples().iter().map(|x| x.to_bits()));
     }
@@ -850,13 +876,15 @@ fn gpu_moments_words(grid: usize, polar: usize, lights: usize, vis_n: usize) -> 
     let brdf = (1 + 2 * (grid + 1) * (grid + 1)) * polar;
     let point = 3 * (1 + 2 * (vis_n + 1) * (vis_n + 1));
     (
-        GPU_MOMENTS_HEADER + GPU_MOMENTS_LIGHT_WORDS * lights + brdf,
+        GPU_SHADE_HEADER + GPU_MOMENTS_LIGHT_WORDS * lights + brdf,
         point,
     )
 }
 
-/// Header words of `wgsl::SHADE_MOMENTS`'s table.
-const GPU_MOMENTS_HEADER: usize = 8;
+/// Header words common to `wgsl::SHADE` and `wgsl::SHADE_MOMENTS` (shade_lib.wgsl).
+const GPU_SHADE_HEADER: usize = 8;
+/// Words per light of `wgsl::SHADE`'s table.
+const GPU_SHADE_LIGHT_WORDS: usize = 8;
 /// Words per light of `wgsl::SHADE_MOMENTS`'s table.
 const GPU_MOMENTS_LIGHT_WORDS: usize = 17;
 
@@ -877,37 +905,12 @@ pub fn gpu_moments_table(
         return None;
     }
     let (fixed, per_point) = gpu_moments_words(grid, views.len(), lights.len(), vn);
-    let off_brdf = GPU_MOMENTS_HEADER + GPU_MOMENTS_LIGHT_WORDS * lights.len();
-    let mut w: Vec<u32> = Vec::with_capacity(fixed + per_point * moments.len());
-    w.extend([
-        lights.len() as u32,
-        grid as u32,
-        views.len() as u32,
-        sat.s_max().to_bits(),
-        vn as u32,
-        GPU_MOMENTS_HEADER as u32,
-        off_brdf as u32,
-        fixed as u32,
-    ]);
-    for l in lights {
-        let (c, e, g) = (l.centre(), l.energy(), l.gradient());
-        let mut words = vec![c.x, c.y, c.z, l.half_diagonal(), l.inv_solid_angle()];
-        words.extend(e);
-        words.extend(g.iter().flat_map(|v| v.to_array()));
-        w.extend(words.into_iter().map(f32::to_bits));
-    }
-    let sat_words = |w: &mut Vec<u32>, v: &steradian_core::sat::SatView<'_>| {
-        w.push(v.exponent() as u32);
-        // `gpu_words` = 4 header words, then the entries.
-        w.extend(v.gpu_words().skip(steradian_core::sat::GPU_HEADER_WORDS));
-    };
-    for v in &views {
-        sat_words(&mut w, v);
-    }
+    let mut w = gpu_shade_prefix(sat, &views, lights, true, vn, &[]);
     debug_assert_eq!(w.len(), fixed);
+    w.reserve(per_point * moments.len());
     for m in moments {
         for t in &m.tables() {
-            sat_words(&mut w, t);
+            push_sat_words(&mut w, t);
         }
     }
     debug_assert_eq!(w.len(), fixed + per_point * moments.len());

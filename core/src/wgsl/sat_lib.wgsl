@@ -75,8 +75,11 @@ fn sat_box_sum(base: u32, e: i32, w: u32, ax: Axis, ay: Axis) -> f32 {
     let x_box = sat_x(r0, r1, ax.a0, ax.a1);
     let x_top = sat_x(r1, r1p, ax.a0, ax.a1);
     let x_bottom = sat_x(r0, r0p, ax.a0, ax.a1);
-    let q = (x_box + ay.a1 * x_top) - ay.a0 * x_bottom;
-    // q * 2^e in two steps: WGSL's ldexp needs its exponent within [-126, 127].
+    return scale2((x_box + ay.a1 * x_top) - ay.a0 * x_bottom, e);
+}
+
+// x * 2^e in two steps: WGSL's ldexp needs its exponent within [-126, 127].
+fn scale2(x: f32, e: i32) -> f32 {
     let e_half = e / 2;
-    return ldexp(ldexp(q, e_half), e - e_half);
+    return ldexp(ldexp(x, e_half), e - e_half);
 }

@@ -2,42 +2,15 @@
 // `shade::shade_moments` with an isotropic BRDF SAT and one `VisMoments` per point; see
 // `wgsl::SHADE_MOMENTS` for the layout). Input columns [tx, ty, tz, bx, by, bz, nx, ny, nz,
 // wox, woy, woz, point_index], output [r, g, b]. Specified for finite inputs only; see
-// `steradian_core::wgsl`. The BRDF box sums are those of sat_lib.wgsl (concatenated before
-// this file by `wgsl.rs`); the visibility moments read the three exact integer tables of
-// the point directly (`vis_moments::VisMoments::moments`).
+// `steradian_core::wgsl`. The BRDF box sums and the shared shading pieces are those of
+// sat_lib.wgsl and shade_lib.wgsl (concatenated before this file by `wgsl.rs`); the
+// visibility moments read the three exact integer tables of the point directly
+// (`vis_moments::VisMomentsView::moments`).
 
-@group(0) @binding(3) var<storage, read> table: array<u32>;
-
-const FRAC_1_SQRT_2: f32 = 0.7071067811865476;
-const SQRT_2: f32 = 1.4142135623730951;
 // 2^61: above it a product s * (V >> k) might not fit the 64-bit difference.
 const TWO_POW_61: f32 = 2305843009213693952.0;
-
-// Header words.
-const H_LIGHTS: u32 = 0u;
-const H_GRID: u32 = 1u;
-const H_POLAR: u32 = 2u;
-const H_SMAX: u32 = 3u;
-const H_VIS_N: u32 = 4u;
-const H_OFF_LIGHTS: u32 = 5u;
-const H_OFF_BRDF: u32 = 6u;
-const H_OFF_VIS: u32 = 7u;
 // Words per light: centre, r, 1/Ω, E (RGB), gradient (3 × RGB).
 const LIGHT_WORDS: u32 = 17u;
-
-fn tf(i: u32) -> f32 {
-    return bitcast<f32>(table[i]);
-}
-
-fn tv3(i: u32) -> vec3<f32> {
-    return vec3<f32>(tf(i), tf(i + 1u), tf(i + 2u));
-}
-
-// x * 2^e in two steps: WGSL's ldexp needs its exponent within [-126, 127].
-fn scale2(x: f32, e: i32) -> f32 {
-    let e_half = e / 2;
-    return ldexp(ldexp(x, e_half), e - e_half);
-}
 
 // ---- 64-bit integers as (low, high) u32 pairs (sub64, i64_to_f32: sat_lib.wgsl) ----
 
@@ -92,14 +65,6 @@ fn shl64(a: vec2<u32>, k: u32) -> vec2<u32> {
 
 // ---- BRDF SAT: integral and plane-fit gradient (`BrdfSat::integral_gradient`) ----
 
-// Box sum of BRDF table `k` (its exponent word, then its entries) over precomputed axes.
-fn brdf_box(k: u32, w: u32, ax: Axis, ay: Axis) -> f32 {
-    let w1 = w + 1u;
-    let stride = 1u + 2u * w1 * w1;
-    let t0 = table[H_OFF_BRDF] + k * stride;
-    return sat_box_sum(t0 + 1u, bitcast<i32>(table[t0]), w, ax, ay);
-}
-
 // [whole, right - left, top - bottom] of BRDF table `k` around `tc` with half-side `h`
 // (texel units): the whole square, then twice its right (top) half minus the whole.
 fn brdf_parts(k: u32, w: u32, tc: vec2<f32>, h: f32) -> vec3<f32> {
@@ -135,53 +100,33 @@ fn vis_axis(pc: f32, hn: f32, h: f32, nf: f32) -> VisAxis {
     return VisAxis(o, fc, lo, hi);
 }
 
-// Texels [i0, i1): one partly covered texel (covered width w, covered centre `mid`
-// relative to the origin) or a run of whole texels (w = 1).
-struct Seg {
-    i0: u32,
-    i1: u32,
-    partial: bool,
-    w: f32,
-    mid: f32,
+// One axis as three blocks of texels (`vis_moments::axis_knots`): the partly covered first
+// texel [x0, x1), the run of whole texels [x1, x2), the partly covered last texel [x2, x3);
+// `w` the blocks' covered lengths (the run's is 1), `mid` the covered centres of the first
+// and last texels relative to the origin.
+struct Knots {
+    x: array<u32, 4>,
+    w: array<f32, 3>,
+    mid: array<f32, 3>,
 }
 
-struct Segs {
-    s: array<Seg, 3>,
-    n: u32,
-}
-
-// [lo, hi] (relative to the origin `o`, inside the table) as the partial first texel,
-// the whole texels between and the partial last texel (`vis_moments::segments`).
-fn segments(lo: f32, hi: f32, o: f32, n: u32) -> Segs {
-    var out: Segs;
-    out.n = 0u;
-    if (!(hi > lo)) {
-        return out;
-    }
+// [lo, hi] (relative to the integer origin `o`, inside the table, lo <= hi) on an n-texel
+// axis: c0 = floor(lo), c1 = floor(hi) (at most n − 1), knots [c0, min(c0 + 1, c1), c1,
+// c1 + 1]; when both ends share a texel the last block carries [lo, hi].
+fn axis_knots(lo: f32, hi: f32, o: f32, n: u32) -> Knots {
     let last = f32(n - 1u);
     let c0 = min(floor(lo) + o, last);
     let c1 = min(floor(hi) + o, last);
+    let split = c0 < c1;
+    let e0 = (c0 + 1.0) - o;
+    let start = select(lo, c1 - o, split);
     let i0 = u32(c0);
     let i1 = u32(c1);
-    if (c0 == c1) {
-        out.s[0] = Seg(i0, i0 + 1u, true, hi - lo, 0.5 * (lo + hi));
-        out.n = 1u;
-        return out;
-    }
-    let e0 = (c0 + 1.0) - o;
-    out.s[0] = Seg(i0, i0 + 1u, true, e0 - lo, 0.5 * (lo + e0));
-    var k = 1u;
-    if (c1 > c0 + 1.0) {
-        out.s[k] = Seg(i0 + 1u, i1, false, 1.0, 0.0);
-        k = k + 1u;
-    }
-    let e1 = c1 - o;
-    if (hi > e1) {
-        out.s[k] = Seg(i1, i1 + 1u, true, hi - e1, 0.5 * (e1 + hi));
-        k = k + 1u;
-    }
-    out.n = k;
-    return out;
+    return Knots(
+        array<u32, 4>(i0, min(i0 + 1u, i1), i1, i1 + 1u),
+        array<f32, 3>(select(0.0, e0 - lo, split), 1.0, hi - start),
+        array<f32, 3>(0.5 * (lo + e0), 0.0, 0.5 * (start + hi)),
+    );
 }
 
 // Exact integer box [i0, i1) x [j0, j1) of the table whose entries start at `base`.
@@ -237,7 +182,7 @@ fn run_moment(
 
 // (f, m.x, m.y) of the square with centre `p` and half-side `hd` (disk units) from the
 // three tables [V, XV, YV] of an n×n map starting at word `vb`, each `ts` words (its
-// exponent, then its entries): `VisMoments::moments` with `inside`, outside the table
+// exponent, then its entries): `VisMomentsView::moments` with `inside`, outside the table
 // visible.
 fn vis_moments(vb: u32, n: u32, ts: u32, p: vec2<f32>, hd: f32) -> vec3<f32> {
     let hn = 0.5 * f32(n);
@@ -248,8 +193,8 @@ fn vis_moments(vb: u32, n: u32, ts: u32, p: vec2<f32>, hd: f32) -> vec3<f32> {
     let nf = f32(n);
     let ax = vis_axis(p.x, hn, h, nf);
     let ay = vis_axis(p.y, hn, h, nf);
-    let xs = segments(ax.lo, ax.hi, ax.o, n);
-    let ys = segments(ay.lo, ay.hi, ay.o, n);
+    let kx = axis_knots(ax.lo, ax.hi, ax.o, n);
+    let ky = axis_knots(ay.lo, ay.hi, ay.o, n);
     let w1 = n + 1u;
     let ev = bitcast<i32>(table[vb]);
     let ex = bitcast<i32>(table[vb + ts]);
@@ -263,30 +208,33 @@ fn vis_moments(vb: u32, n: u32, ts: u32, p: vec2<f32>, hd: f32) -> vec3<f32> {
     let sy_int = i32(ay.o) - i32(floor(hn));
     let fx = ax.fc - odd;
     let fy = ay.fc - odd;
+    // The nine blocks (`vis_moments::combine_blocks`): x-block a, y-block c.
     var s = 0.0;
     var mx = 0.0;
     var my = 0.0;
-    for (var a = 0u; a < xs.n; a = a + 1u) {
-        let sx = xs.s[a];
-        for (var c = 0u; c < ys.n; c = c + 1u) {
-            let sy = ys.s[c];
-            let vi = ibox(vbase, w1, sx.i0, sx.i1, sy.i0, sy.i1);
+    for (var c = 0u; c < 3u; c = c + 1u) {
+        let j0 = ky.x[c];
+        let j1 = ky.x[c + 1u];
+        for (var a = 0u; a < 3u; a = a + 1u) {
+            let i0 = kx.x[a];
+            let i1 = kx.x[a + 1u];
+            let vi = ibox(vbase, w1, i0, i1, j0, j1);
             let bv = scale2(i64_to_f32(vi), ev);
-            s = s + (sx.w * sy.w) * bv;
+            s = s + (kx.w[a] * ky.w[c]) * bv;
             var tx: f32;
-            if (sx.partial) {
-                tx = sx.w * bv * (sx.mid - ax.fc);
+            if (a == 1u) {
+                tx = run_moment(xbase, ex, vi, ev, bv, sx_int, fx, w1, i0, i1, j0, j1);
             } else {
-                tx = run_moment(xbase, ex, vi, ev, bv, sx_int, fx, w1, sx.i0, sx.i1, sy.i0, sy.i1);
+                tx = kx.w[a] * bv * (kx.mid[a] - ax.fc);
             }
-            mx = mx + sy.w * tx;
+            mx = mx + ky.w[c] * tx;
             var ty: f32;
-            if (sy.partial) {
-                ty = sy.w * bv * (sy.mid - ay.fc);
+            if (c == 1u) {
+                ty = run_moment(ybase, ey, vi, ev, bv, sy_int, fy, w1, i0, i1, j0, j1);
             } else {
-                ty = run_moment(ybase, ey, vi, ev, bv, sy_int, fy, w1, sx.i0, sx.i1, sy.i0, sy.i1);
+                ty = ky.w[c] * bv * (ky.mid[c] - ay.fc);
             }
-            my = my + sx.w * ty;
+            my = my + kx.w[a] * ty;
         }
     }
     let area = 4.0 * h * h;
@@ -301,18 +249,6 @@ fn vis_moments(vb: u32, n: u32, ts: u32, p: vec2<f32>, hd: f32) -> vec3<f32> {
 
 // ---- The kernel (`shade::light_moments`) ----
 
-// Extended equal-area map of a unit direction (`rsl::map_extended`).
-fn map_ext(d: vec3<f32>) -> vec2<f32> {
-    if (d.z >= 0.0) {
-        return d.xy / sqrt(1.0 + d.z);
-    }
-    let s2 = d.x * d.x + d.y * d.y;
-    if (s2 > 0.0) {
-        return d.xy * (sqrt(1.0 - d.z) / sqrt(s2));
-    }
-    return vec2<f32>(SQRT_2, 0.0);
-}
-
 // x clamped to [0, hi] in the scalar kernel's order (`shade::clamp_keep_nan`).
 fn clamp_to(x: f32, hi: f32) -> f32 {
     return select(select(x, hi, x > hi), 0.0, x < 0.0);
@@ -325,41 +261,29 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     if (row >= n) {
         return;
     }
-    let t = vec3<f32>(input[row], input[n + row], input[2u * n + row]);
-    let b = vec3<f32>(input[3u * n + row], input[4u * n + row], input[5u * n + row]);
-    let nn = vec3<f32>(input[6u * n + row], input[7u * n + row], input[8u * n + row]);
-    let wo = vec3<f32>(input[9u * n + row], input[10u * n + row], input[11u * n + row]);
-    let point = u32(input[12u * n + row]);
+    let sp = shade_point(row, n);
+    let t = sp.t;
+    let b = sp.b;
+    let nn = sp.n;
     var acc = vec3<f32>(0.0, 0.0, 0.0);
-    let wl = vec3<f32>(dot(wo, t), dot(wo, b), dot(wo, nn));
+    let wl = vec3<f32>(dot(sp.wo, t), dot(sp.wo, b), dot(sp.wo, nn));
     if (wl.z > 0.0) {
-        // View constants of the isotropic BRDF SAT (`BrdfSat::locate`).
-        let wn = wl / length(wl);
-        let pv = wn.xy / sqrt(1.0 + wn.z);
-        let sv = sqrt(pv.x * pv.x + pv.y * pv.y);
-        let m = table[H_POLAR];
-        let x = clamp(sv / tf(H_SMAX) * f32(m - 1u), 0.0, f32(m - 1u));
-        let k0 = min(u32(x), m - 2u);
-        let tw = x - f32(k0);
-        var rc = 1.0;
-        var rs = 0.0;
-        if (sv > 0.0) {
-            rc = pv.x / sv;
-            rs = pv.y / sv;
-        }
+        let vt = view_tables(wl);
+        let k0 = vt.k0;
+        let tw = vt.tw;
+        let rc = vt.rc;
+        let rs = vt.rs;
         let grid = table[H_GRID];
         let half_b = 0.5 * f32(grid);
-        let vn = table[H_VIS_N];
+        let vn = table[H_MAP_N];
         let ts = 1u + 2u * (vn + 1u) * (vn + 1u);
-        let vbase = table[H_OFF_VIS] + point * 3u * ts;
+        let vbase = table[H_OFF_MAPS] + sp.point * 3u * ts;
         let nl = table[H_LIGHTS];
         let lo = table[H_OFF_LIGHTS];
         for (var i = 0u; i < nl; i = i + 1u) {
             let o = lo + LIGHT_WORDS * i;
-            let c = tv3(o);
             let r = tf(o + 3u);
-            let cl = vec3<f32>(dot(c, t), dot(c, b), dot(c, nn));
-            let p = map_ext(cl / length(cl));
+            let p = light_square_centre(tv3(o), sp);
             if (length(p) - r >= 1.0) {
                 continue;
             }
