@@ -309,6 +309,24 @@ fn close(a: [f32; 3], b: [f32; 3], tol: f32) -> bool {
     (0..3).all(|c| (a[c] - b[c]).abs() <= tol * m.max(1e-30))
 }
 
+/// Every point and channel of `other` within `tol` of `scalar` (relative to the point's
+/// largest channel, [`close`]); prints the largest relative difference, labelled `what`.
+fn assert_lane_by_lane(what: &str, scalar: &[[f32; 3]], other: &[[f32; 3]], tol: f32) {
+    assert_eq!(scalar.len(), other.len(), "{what}");
+    let mut worst = 0.0f32;
+    for (p, (a, b)) in scalar.iter().zip(other).enumerate() {
+        let m = a.iter().fold(0.0f32, |m, x| m.max(x.abs()));
+        for c in 0..3 {
+            worst = worst.max((a[c] - b[c]).abs() / m.max(1e-30));
+        }
+        assert!(
+            close(*a, *b, tol),
+            "{what} point {p}: scalar {a:?} vs {b:?}"
+        );
+    }
+    say(&format!("{what}: largest relative difference {worst:.2e}"));
+}
+
 #[test]
 fn kernel_matches_the_analysis_pipeline() {
     let s = small(false);
@@ -336,20 +354,12 @@ fn simd_matches_scalar_lane_by_lane() {
         for q in [VdtQuery::Gradient, VdtQuery::Eq9] {
             let scalar = sh::shade_points(&s.scene, &s.sat, &s.vdts, &s.lights, q);
             let simd = sh::shade_points_simd(&s.scene, &s.sat, &s.vdts, &s.lights, q).unwrap();
-            let mut worst = 0.0f32;
-            for (p, (a, b)) in scalar.iter().zip(&simd).enumerate() {
-                let m = a.iter().fold(0.0f32, |m, x| m.max(x.abs()));
-                for c in 0..3 {
-                    worst = worst.max((a[c] - b[c]).abs() / m.max(1e-30));
-                }
-                assert!(
-                    close(*a, *b, steradian_simd::shade::REL_TOL),
-                    "glossy {glossy} {q:?} point {p}: scalar {a:?} simd {b:?}"
-                );
-            }
-            say(&format!(
-                "SIMD vs scalar (glossy {glossy}, {q:?}): largest relative difference {worst:.2e}"
-            ));
+            assert_lane_by_lane(
+                &format!("SIMD vs scalar (glossy {glossy}, {q:?})"),
+                &scalar,
+                &simd,
+                steradian_simd::shade::REL_TOL,
+            );
         }
     }
 }
@@ -367,20 +377,12 @@ fn simd_moments_matches_scalar_lane_by_lane() {
         for (what, lights) in [("gradient", &s.lights), ("uniform", flat)] {
             let scalar = sh::shade_points_moments(&s.scene, &s.sat, &moments, lights);
             let simd = sh::shade_points_moments_simd(&s.scene, &s.sat, &moments, lights).unwrap();
-            let mut worst = 0.0f32;
-            for (p, (a, b)) in scalar.iter().zip(&simd).enumerate() {
-                let m = a.iter().fold(0.0f32, |m, x| m.max(x.abs()));
-                for c in 0..3 {
-                    worst = worst.max((a[c] - b[c]).abs() / m.max(1e-30));
-                }
-                assert!(
-                    close(*a, *b, steradian_simd::shade::MOMENTS_REL_TOL),
-                    "glossy {glossy} {what} point {p}: scalar {a:?} simd {b:?}"
-                );
-            }
-            say(&format!(
-                "SIMD moments vs scalar (glossy {glossy}, {what}): largest relative difference {worst:.2e}"
-            ));
+            assert_lane_by_lane(
+                &format!("SIMD moments vs scalar (glossy {glossy}, {what})"),
+                &scalar,
+                &simd,
+                steradian_simd::shade::MOMENTS_REL_TOL,
+            );
         }
     }
 }
@@ -447,21 +449,15 @@ fn gpu_matches_scalar() {
             g.run_custom(&custom, &input, &mut out)
                 .expect("shade kernel runs");
             let scalar = sh::shade_points(&s.scene, &s.sat, &s.vdts, &s.lights, q);
-            let mut worst = 0.0f32;
-            for (p, &a) in scalar.iter().enumerate() {
-                let b = [0, 1, 2].map(|c| out.data[c * input.n + p]);
-                let m = a.iter().fold(0.0f32, |m, x| m.max(x.abs()));
-                for c in 0..3 {
-                    worst = worst.max((a[c] - b[c]).abs() / m.max(1e-30));
-                }
-                assert!(
-                    close(a, b, steradian_core::wgsl::SHADE_REL_TOL),
-                    "glossy {glossy} {q:?} point {p}: scalar {a:?} gpu {b:?}"
-                );
-            }
-            say(&format!(
-                "GPU vs scalar (glossy {glossy}, {q:?}): largest relative difference {worst:.2e}"
-            ));
+            let gpu: Vec<[f32; 3]> = (0..input.n)
+                .map(|p| [0, 1, 2].map(|c| out.data[c * input.n + p]))
+                .collect();
+            assert_lane_by_lane(
+                &format!("GPU vs scalar (glossy {glossy}, {q:?})"),
+                &scalar,
+                &gpu,
+                steradian_core::wgsl::SHADE_REL_TOL,
+            );
         }
     }
 }

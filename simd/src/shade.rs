@@ -684,13 +684,25 @@ pub fn shade_moments_x8(
 }
 
 /// Shades every point with [`shade_moments_x8`] (`out[i]` for `points[i]`), 8 at a time;
-/// the tail is padded with the last point. Returns `false` (leaving `out` untouched) if
-/// the tables do not fit [`shade_moments_x8`]'s requirements or the lengths differ.
+/// the tail is padded with the last point. Returns `false` if the lengths differ (`out`
+/// untouched) or a group's tables do not fit [`shade_moments_x8`]'s requirements (the
+/// groups before it written).
 pub fn shade_moments_batch(
     points: &[MomentsInput<'_>],
     brdf: &IsoBrdfTables<'_>,
     lights: &[ShadeLight],
     out: &mut [[f32; 3]],
+) -> bool {
+    by_eight(points, out, |g| shade_moments_x8(g, brdf, lights))
+}
+
+/// `out[i]` = lane `i mod 8` of `x8` on the group of eight points holding `points[i]` (the
+/// tail padded with the last point); `false` when the lengths differ (`out` untouched) or
+/// `x8` refuses a group (the groups before it written).
+fn by_eight<P: Copy>(
+    points: &[P],
+    out: &mut [[f32; 3]],
+    mut x8: impl FnMut(&[P; 8]) -> Option<[[f32; 3]; 8]>,
 ) -> bool {
     if points.len() != out.len() {
         return false;
@@ -698,23 +710,19 @@ pub fn shade_moments_batch(
     let Some(last) = points.last() else {
         return true;
     };
-    let mut i = 0;
-    while i < points.len() {
-        let group: [MomentsInput<'_>; 8] =
-            core::array::from_fn(|k| *points.get(i + k).unwrap_or(last));
-        let Some(r) = shade_moments_x8(&group, brdf, lights) else {
+    for (group, o) in points.chunks(8).zip(out.chunks_mut(8)) {
+        let g: [P; 8] = core::array::from_fn(|j| *group.get(j).unwrap_or(last));
+        let Some(r) = x8(&g) else {
             return false;
         };
-        let m = (points.len() - i).min(8);
-        out[i..i + m].copy_from_slice(&r[..m]);
-        i += 8;
+        o.copy_from_slice(&r[..o.len()]);
     }
     true
 }
 
 /// Shades every point (`out[i]` for `points[i]`), 8 at a time; the tail is padded with the
-/// last point. Returns `false` (leaving `out` untouched) if the tables or VDTs do not fit
-/// [`shade_x8`]'s requirements or the lengths differ.
+/// last point. Returns `false` if the lengths differ (`out` untouched) or a group's tables
+/// or VDTs do not fit [`shade_x8`]'s requirements (the groups before it written).
 pub fn shade_batch(
     points: &[ShadeInput<'_>],
     brdf: &IsoBrdfTables<'_>,
@@ -722,22 +730,5 @@ pub fn shade_batch(
     lights: &[ShadeLight],
     out: &mut [[f32; 3]],
 ) -> bool {
-    if points.len() != out.len() {
-        return false;
-    }
-    let Some(last) = points.last() else {
-        return true;
-    };
-    let mut i = 0;
-    while i < points.len() {
-        let group: [ShadeInput<'_>; 8] =
-            core::array::from_fn(|k| *points.get(i + k).unwrap_or(last));
-        let Some(r) = shade_x8(&group, brdf, query, lights) else {
-            return false;
-        };
-        let m = (points.len() - i).min(8);
-        out[i..i + m].copy_from_slice(&r[..m]);
-        i += 8;
-    }
-    true
+    by_eight(points, out, |g| shade_x8(g, brdf, query, lights))
 }
