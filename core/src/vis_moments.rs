@@ -470,6 +470,13 @@ mod tests {
             cov[9] = bad;
             assert!(VisMoments::build_coverage(8, &cov).is_err(), "{bad}");
         }
+        // a view of the tables queries as the owned tables; tables of two sizes are refused
+        let [v, x, y] = t.tables();
+        let view = VisMomentsView::new(v, x, y).unwrap();
+        let q = (Vec2::new(0.3, -0.2), 0.45);
+        assert_eq!(view.moments(q.0, q.1), t.moments(q.0, q.1));
+        let small = VisMoments::build(4, &[true; 16]).unwrap();
+        assert!(VisMomentsView::new(v, small.tables()[1], y).is_err());
         // all occluded, square inside the table: f = 0, m = 0
         let t = VisMoments::build(8, &[false; 64]).unwrap();
         let (f, m) = t.moments(Vec2::new(0.1, 0.1), 0.4);
