@@ -8,8 +8,8 @@
 use std::hint::black_box;
 
 use criterion::{BenchmarkId, Criterion, Throughput, criterion_group, criterion_main};
-use steradian_core::brdf::{Brdf, Phong, Ward};
-use steradian_core::brdf_sat::{BrdfSat, Resolution};
+use steradian_core::lobe::brdf::{Brdf, Phong, Ward};
+use steradian_core::rsl::brdf_sat::{BrdfSat, Resolution};
 use steradian_harness::report::brdf::{Query, gl4_square, queries};
 
 const N: usize = 4096;

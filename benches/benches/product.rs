@@ -1,5 +1,5 @@
-//! Criterion bench of the lobe product (`steradian_core::product`): the scalar kernel with
-//! the built-in table, the same kernel as a batch (`steradian_simd::product::product_slices`,
+//! Criterion bench of the lobe product (`steradian_core::lobe::product`): the scalar kernel with
+//! the built-in table, the same kernel as a batch (`steradian_simd::lobe::product::product_slices`,
 //! 16 lanes on AVX-512 builds, else 8), and the spherical-Gaussian closed form with no
 //! table (`ProductFit::SphericalGaussian`) both ways; also the 8-lane batch kernel
 //! `product_x8` (`table/simd-x8`). Same inputs for every row: `N` pairs
@@ -12,10 +12,10 @@ use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use std::hint::black_box;
 use steradian_core::Vec3;
 use steradian_core::lobe::CosineLobe;
-use steradian_core::product::{ProductFit, ProductTable, product_with};
+use steradian_core::lobe::product::{ProductFit, ProductTable, product_with};
 use steradian_harness::rng::Rng;
 use steradian_simd::LobeX8;
-use steradian_simd::product::{product_slices, product_x8};
+use steradian_simd::lobe::product::{product_slices, product_x8};
 
 const N: usize = 1 << 14;
 const SEED: u64 = 0x10be_0001;

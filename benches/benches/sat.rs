@@ -12,7 +12,7 @@ use std::hint::black_box;
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use imageproc::image::{GrayImage, Luma};
 use imageproc::integral_image::{integral_image, sum_image_pixels};
-use steradian_core::sat::Sat;
+use steradian_core::rsl::sat::Sat;
 use steradian_harness::rng::Rng;
 use summed_area::SummedArea;
 
@@ -157,7 +157,7 @@ fn sat(c: &mut Criterion) {
         std::array::from_fn(|c| d.boxes.iter().map(|q| q[c] as f32).collect());
     g.bench_function("steradian integer corners SIMD", |b| {
         b.iter(|| {
-            steradian_simd::sat::box_sum_slices(
+            steradian_simd::rsl::sat::box_sum_slices(
                 &view, &icols[0], &icols[1], &icols[2], &icols[3], &mut out,
             );
             black_box(&out);
@@ -204,7 +204,7 @@ fn sat(c: &mut Criterion) {
     let cols: [Vec<f32>; 4] = std::array::from_fn(|c| d.frac.iter().map(|q| q[c]).collect());
     g.bench_function("steradian fractional SIMD", |b| {
         b.iter(|| {
-            steradian_simd::sat::box_sum_slices(
+            steradian_simd::rsl::sat::box_sum_slices(
                 &view, &cols[0], &cols[1], &cols[2], &cols[3], &mut out,
             );
             black_box(&out);

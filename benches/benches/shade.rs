@@ -1,4 +1,4 @@
-//! RSL shading (`steradian_core::shade`): scalar vs SIMD (8 points per call) over the same
+//! RSL shading (`steradian_core::rsl::shade`): scalar vs SIMD (8 points per call) over the same
 //! points × K lights, for a diffuse and a glossy BRDF SAT, and the scalar moments kernel
 //! (`shade_moments`: linear BRDF, linear light, visibility moments) and its SIMD twin beside
 //! them. Throughput is in RSL evaluations (points × K) per second.
@@ -8,11 +8,11 @@
 use std::hint::black_box;
 
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
-use steradian_core::brdf::{Brdf, Lambert, Phong};
-use steradian_core::shade::{self, ShadeLight, VdtQuery, VdtVisibility};
+use steradian_core::lobe::brdf::{Brdf, Lambert, Phong};
+use steradian_core::rsl::shade::{self, ShadeLight, VdtQuery, VdtVisibility};
 use steradian_harness::env::{self, decompose};
 use steradian_harness::shade::{self as sh, Scene};
-use steradian_simd::shade::{IsoBrdfTables, MomentsInput, shade_batch, shade_moments_batch};
+use steradian_simd::rsl::shade::{IsoBrdfTables, MomentsInput, shade_batch, shade_moments_batch};
 
 fn bench(c: &mut Criterion) {
     let cube = env::default_sky(32).unwrap();

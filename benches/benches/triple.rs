@@ -1,5 +1,5 @@
 //! Criterion bench of the lobe-sum rendering integral `∫ R·L·V`
-//! (`steradian_core::lobe_sum::triple`): a Phong BRDF (cosine on the light), one spherical
+//! (`steradian_core::lobe::sum::triple`): a Phong BRDF (cosine on the light), one spherical
 //! light and 1, 4, 16, 64 occluder lobes around it, at pruning thresholds `t = 0` (every
 //! product) and `t = 1e-3` of the unshadowed value (the paper's setting, section 4.3).
 //! The throughput unit is one shaded point; a product kernel call is the unit of work, so
@@ -10,9 +10,9 @@
 use criterion::{BenchmarkId, Criterion, Throughput, criterion_group, criterion_main};
 use std::hint::black_box;
 use steradian_core::Vec3;
-use steradian_core::cap::{CapFit, SphericalCap};
 use steradian_core::lobe::Phong;
-use steradian_core::lobe_sum::{
+use steradian_core::lobe::cap::{CapFit, SphericalCap};
+use steradian_core::lobe::sum::{
     Cosine, LobeSum, ProductCounts, light_with_cosine, phong_reflectance, triple,
 };
 use steradian_harness::rng::Rng;

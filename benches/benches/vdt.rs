@@ -16,8 +16,8 @@ use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use imageproc::distance_transform::euclidean_squared_distance_transform;
 use imageproc::image::{GrayImage, Luma};
 use steradian_core::Vec2;
-use steradian_core::sat::Sat;
-use steradian_core::vdt::{Vdt, scratch_len, signed_distance_into};
+use steradian_core::rsl::sat::Sat;
+use steradian_core::rsl::vdt::{Vdt, scratch_len, signed_distance_into};
 use steradian_harness::rng::Rng;
 use steradian_harness::vdt::spheres_mask;
 
@@ -85,7 +85,7 @@ fn queries(c: &mut Criterion) {
     });
     g.bench_function("simd", |b| {
         b.iter(|| {
-            steradian_simd::vdt::query_slices(&view, &u, &v, &r, &mut e9, &mut gr);
+            steradian_simd::rsl::vdt::query_slices(&view, &u, &v, &r, &mut e9, &mut gr);
             black_box(&e9);
         })
     });

@@ -57,24 +57,13 @@ extern crate std;
 extern crate alloc;
 
 mod error;
-mod math;
+pub mod math;
 
-pub mod brdf;
-#[cfg(feature = "alloc")]
-pub mod brdf_sat;
-pub mod cap;
 pub mod frame;
-pub mod hemisphere;
+pub mod grid;
 pub mod lobe;
-pub mod lobe_sum;
-pub mod product;
 pub mod rsl;
-pub mod sat;
-pub mod shade;
 pub mod table;
-pub mod vdt;
-pub mod vis_moments;
-pub mod visibility;
 pub mod wgsl;
 
 pub use error::Error;

@@ -1,26 +1,25 @@
 //! The one math shim: every float function the kernels use goes through here, so no other
-//! module needs a `cfg`. With the `std` feature the standard library is used, otherwise the
-//! `libm` crate. Add a function with one line in the `shim!` list below.
+//! module needs a `cfg`. With the `std` feature the standard library is used, otherwise (or with
+//! `force-libm`) the `libm` crate. Add a function with one line in the `shim!` list below.
 
-// Some functions serve only modules behind the `alloc` feature; without it they are unused.
 macro_rules! shim {
     ($( $name:ident ( $t:ty $(, $arg:ident)* ) => $method:ident, $libm:ident ; )*) => {
-        #[cfg(feature = "std")]
+        #[cfg(all(feature = "std", not(feature = "force-libm")))]
         mod imp {
             $(
+                #[doc = concat!("`", stringify!($t), "::", stringify!($method), "` of the standard library.")]
                 #[inline(always)]
-                #[cfg_attr(not(feature = "alloc"), allow(dead_code))]
                 pub fn $name(x: $t $(, $arg: $t)*) -> $t {
                     x.$method($($arg),*)
                 }
             )*
         }
 
-        #[cfg(all(not(feature = "std"), feature = "libm"))]
+        #[cfg(any(all(not(feature = "std"), feature = "libm"), feature = "force-libm"))]
         mod imp {
             $(
+                #[doc = concat!("`libm::", stringify!($libm), "`.")]
                 #[inline(always)]
-                #[cfg_attr(not(feature = "alloc"), allow(dead_code))]
                 pub fn $name(x: $t $(, $arg: $t)*) -> $t {
                     libm::$libm(x $(, $arg)*)
                 }
@@ -59,4 +58,4 @@ shim! {
     cbrt64(f64) => cbrt, cbrt;
 }
 
-pub(crate) use imp::*;
+pub use imp::*;

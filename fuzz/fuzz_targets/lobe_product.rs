@@ -1,5 +1,5 @@
-//! Lobe products, SIMD (`steradian_simd::product`) vs scalar
-//! (`steradian_core::product::product_with`) on arbitrary lobes from raw bytes: every field
+//! Lobe products, SIMD (`steradian_simd::lobe::product`) vs scalar
+//! (`steradian_core::lobe::product::product_with`) on arbitrary lobes from raw bytes: every field
 //! an arbitrary `f32` (NaN, ±∞, ±0, subnormals, huge values), or, per lane when a flag bit
 //! says so, the exponent folded into the table's domain `[0, 1e5]` so that the vector path
 //! (not only the scalar fallback) sees most inputs. Checked, for `product_x8` and for
@@ -23,8 +23,8 @@
 use libfuzzer_sys::fuzz_target;
 use steradian_core::Vec3;
 use steradian_core::lobe::CosineLobe;
-use steradian_core::product::{self, ProductFit, ProductTable};
-use steradian_simd::product::{
+use steradian_core::lobe::product::{self, ProductFit, ProductTable};
+use steradian_simd::lobe::product::{
     EXPONENT_REL_TOL, INTEGRAL_REL_TOL, SCALE_REL_TOL, UNDERFLOW_ABS, product_slices, product_x8,
 };
 use steradian_simd::{LobeX8, Vec3x8, f32x8};

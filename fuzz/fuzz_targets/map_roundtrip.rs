@@ -4,7 +4,7 @@
 #![no_main]
 
 use libfuzzer_sys::fuzz_target;
-use steradian_core::{Vec2, Vec3, frame::normalize_or_zero, hemisphere};
+use steradian_core::{Vec2, Vec3, frame::normalize_or_zero, rsl::hemisphere};
 
 fuzz_target!(|data: [u32; 5]| {
     let [x, y, z, u, v] = data.map(f32::from_bits);

@@ -9,8 +9,8 @@
 use libfuzzer_sys::fuzz_target;
 use steradian_core::frame::Frame;
 use steradian_core::rsl::Rsl;
-use steradian_core::shade::{BrdfIntegral, ShadeLight, light_moments};
-use steradian_core::vis_moments::VisMoments;
+use steradian_core::rsl::shade::{BrdfIntegral, ShadeLight, light_moments};
+use steradian_core::rsl::vis_moments::VisMoments;
 use steradian_core::{Vec2, Vec3};
 
 fn f32_at(d: &[u8], at: usize) -> f32 {

@@ -8,7 +8,7 @@
 #![no_main]
 
 use libfuzzer_sys::fuzz_target;
-use steradian_core::sat::{SatView, axis};
+use steradian_core::rsl::sat::{SatView, axis};
 use steradian_simd::f32x8;
 
 fn f32_at(d: &[u8], at: usize) -> f32 {
@@ -163,7 +163,7 @@ fuzz_target!(|data: &[u8]| {
     for lanes in qs.chunks(8) {
         let col =
             |c: usize| f32x8::new(core::array::from_fn(|k| lanes.get(k).map_or(0.0, |q| q[c])));
-        let r = steradian_simd::sat::box_sum(&sat, col(0), col(1), col(2), col(3));
+        let r = steradian_simd::rsl::sat::box_sum(&sat, col(0), col(1), col(2), col(3));
         for (k, q) in lanes.iter().enumerate() {
             let want = sat.box_sum(q[0], q[1], q[2], q[3]);
             let got = r.as_array()[k];

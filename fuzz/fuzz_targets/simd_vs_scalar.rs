@@ -4,7 +4,7 @@
 #![no_main]
 
 use libfuzzer_sys::fuzz_target;
-use steradian_core::{Vec2, Vec3, cap, hemisphere, lobe};
+use steradian_core::{Vec2, Vec3, lobe, lobe::cap, rsl::hemisphere};
 use steradian_simd::f32x8;
 
 fn same(a: f32, b: f32) -> bool {
@@ -25,12 +25,12 @@ fuzz_target!(|data: &[u8]| {
     let c: Vec<[f32; 8]> = (0..8).map(|k| lanes(data, k)).collect();
     let v = |k: usize| f32x8::from(c[k]);
 
-    let p = steradian_simd::hemisphere::map(steradian_simd::Vec3x8::new(v(0), v(1), v(2)));
+    let p = steradian_simd::rsl::hemisphere::map(steradian_simd::Vec3x8::new(v(0), v(1), v(2)));
     let (pu, pv) = (p.x.to_array(), p.y.to_array());
-    let d = steradian_simd::hemisphere::unmap(steradian_simd::Vec2x8::new(v(0), v(1)));
+    let d = steradian_simd::rsl::hemisphere::unmap(steradian_simd::Vec2x8::new(v(0), v(1)));
     let (dx, dy, dz) = (d.x.to_array(), d.y.to_array(), d.z.to_array());
     let integ = steradian_simd::lobe::integral(v(3), v(4)).to_array();
-    let ex = steradian_simd::cap::exponent_l2(v(5)).to_array();
+    let ex = steradian_simd::lobe::cap::exponent_l2(v(5)).to_array();
     for l in 0..8 {
         let s = hemisphere::map(Vec3::new(c[0][l], c[1][l], c[2][l]));
         assert!(same(s.x, pu[l]) && same(s.y, pv[l]), "map lane {l}");

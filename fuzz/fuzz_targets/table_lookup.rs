@@ -4,7 +4,7 @@
 #![no_main]
 
 use libfuzzer_sys::fuzz_target;
-use steradian_core::{cap, table::TableView};
+use steradian_core::{lobe::cap, table::TableView};
 
 fuzz_target!(|data: &[u8]| {
     if data.len() >= 8 {

@@ -6,7 +6,7 @@
 #![no_main]
 
 use libfuzzer_sys::fuzz_target;
-use steradian_core::vdt::{VdtView, scratch_len, signed_distance_into};
+use steradian_core::rsl::vdt::{VdtView, scratch_len, signed_distance_into};
 
 fn edt(w: usize, h: usize, m: &[bool]) -> Vec<f32> {
     let mut d = vec![0.0; w * h];
@@ -82,7 +82,7 @@ fuzz_target!(|data: &[u8]| {
     }
     let mut e9 = vec![0.0; nq];
     let mut gr = vec![0.0; nq];
-    steradian_simd::vdt::query_slices(&view, &u, &v, &r, &mut e9, &mut gr);
+    steradian_simd::rsl::vdt::query_slices(&view, &u, &v, &r, &mut e9, &mut gr);
     for q in 0..nq {
         let (a, b) = view.query(u[q], v[q], r[q]);
         let nan_in = u[q].is_nan() || v[q].is_nan() || r[q].is_nan();

@@ -17,7 +17,7 @@ pub fn metric(kernel: Kernel) -> &'static str {
 
 /// The documented bound of a kernel in its metric.
 pub fn bound(kernel: Kernel) -> f64 {
-    use steradian_core::{cap, hemisphere, lobe};
+    use steradian_core::{lobe, lobe::cap, rsl::hemisphere};
     match kernel {
         Kernel::HemisphereMap => hemisphere::MAP_ABS_ERROR as f64,
         Kernel::HemisphereUnmap => hemisphere::UNMAP_ABS_ERROR as f64,

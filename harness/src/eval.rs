@@ -9,8 +9,10 @@
 
 use std::io::{BufRead, Write};
 
-use serde_json::{Map, Value, json};
-use steradian_core::{Vec2, Vec3, cap, hemisphere, lobe};
+use serde_json::{Value, json};
+use steradian_core::{Vec2, lobe, lobe::cap, rsl::hemisphere};
+
+use crate::json::{exponent, nonzero, num, number, scale, vector};
 
 /// The kernels `eval` accepts, with their input and output, for `--help` and errors.
 pub const KERNELS: &[(&str, &str)] = &[
@@ -47,73 +49,6 @@ pub const KERNELS: &[(&str, &str)] = &[
         r#"{"mask": ["0110…", …] rows of '0'/'1' ('1' visible, row j along v), "queries": [[u, v, r], …] centre and half-diagonal in texel units} -> {"values": [visible fraction, eq. 9], "values_gradient": [straight-edge variant]}"#,
     ),
 ];
-
-/// An f32 as a JSON number with the shortest round-tripping decimal.
-pub fn num(x: f32) -> Value {
-    let short: f64 = format!("{x}").parse().unwrap_or(f64::NAN);
-    serde_json::Number::from_f64(short).map_or(Value::Null, Value::Number)
-}
-
-fn field<'a>(obj: &'a Map<String, Value>, name: &str) -> Result<&'a Value, String> {
-    obj.get(name)
-        .ok_or_else(|| format!("missing field \"{name}\""))
-}
-
-fn finite_f32(v: &Value, name: &str) -> Result<f32, String> {
-    let x = v
-        .as_f64()
-        .ok_or_else(|| format!("field \"{name}\" must be a number"))?;
-    let f = x as f32;
-    if !f.is_finite() {
-        return Err(format!("field \"{name}\" = {x} is not a finite f32"));
-    }
-    Ok(f)
-}
-
-/// Field `name` of `obj` as a finite f32, or the error message for the line.
-pub(crate) fn number(obj: &Map<String, Value>, name: &str) -> Result<f32, String> {
-    finite_f32(field(obj, name)?, name)
-}
-
-fn vector<const N: usize>(obj: &Map<String, Value>, name: &str) -> Result<[f32; N], String> {
-    let arr = field(obj, name)?
-        .as_array()
-        .ok_or_else(|| format!("field \"{name}\" must be an array of {N} numbers"))?;
-    if arr.len() != N {
-        return Err(format!(
-            "field \"{name}\" must have {N} components, got {}",
-            arr.len()
-        ));
-    }
-    let mut out = [0f32; N];
-    for (o, v) in out.iter_mut().zip(arr) {
-        *o = finite_f32(v, name)?;
-    }
-    Ok(out)
-}
-
-fn nonzero(v: [f32; 3], name: &str) -> Result<Vec3, String> {
-    let v = Vec3::from(v);
-    if v == Vec3::ZERO {
-        return Err(format!("field \"{name}\" must not be the zero vector"));
-    }
-    Ok(v)
-}
-
-fn exponent(obj: &Map<String, Value>) -> Result<f32, String> {
-    let e = number(obj, "exponent")?;
-    if e < 0.0 {
-        return Err(format!("exponent = {e} must be ≥ 0"));
-    }
-    Ok(e)
-}
-
-fn scale(obj: &Map<String, Value>) -> Result<f32, String> {
-    match obj.get("scale") {
-        None => Ok(1.0),
-        Some(v) => finite_f32(v, "scale"),
-    }
-}
 
 /// Evaluates one input line of `kernel`; `Err` is the message for `{"error": ...}`.
 pub fn eval_line(kernel: &str, line: &str) -> Result<Value, String> {

@@ -9,6 +9,7 @@ pub mod backend;
 pub mod env;
 pub mod eval;
 pub mod generate;
+pub mod json;
 pub mod kernels;
 pub mod product;
 pub mod reference;

@@ -43,12 +43,12 @@ enum Command {
         /// Kernel name (see below).
         kernel: String,
     },
-    /// Regenerate the precomputed tables under core/src/tables.
+    /// Regenerate the precomputed tables under core/src/lobe/tables.
     Tables {
         /// Do not write: fail if the committed tables differ from a fresh generation.
         #[arg(long)]
         check: bool,
-        /// Directory of the tables (default: this source tree's core/src/tables).
+        /// Directory of the tables (default: this source tree's core/src/lobe/tables).
         #[arg(long)]
         dir: Option<PathBuf>,
     },

@@ -4,10 +4,10 @@
 
 use serde_json::{Map, Value, json};
 use steradian_core::lobe::CosineLobe;
-use steradian_core::product;
+use steradian_core::lobe::product;
 use steradian_core::{TWO_PI, Vec3};
 
-use crate::eval::{num, number};
+use crate::json::{num, number};
 
 /// Unit lobes in the canonical configuration.
 pub fn canonical_lobes(e1: f32, e2: f32, alpha: f32) -> (CosineLobe, CosineLobe) {

@@ -1,14 +1,14 @@
 //! Summed-area tables in the harness: the f64 brute-force reference, the GPU query through
 //! [`Gpu::run_custom`], the `steradian eval sat-box` handler, and the alternative storage
-//! options the report measures against the one `steradian_core::sat` chose.
+//! options the report measures against the one `steradian_core::rsl::sat` chose.
 
 use serde_json::{Map, Value, json};
-use steradian_core::sat::{Sat, SatView};
+use steradian_core::rsl::sat::{Sat, SatView};
 use steradian_core::wgsl;
 
 use crate::backend::BackendError;
 use crate::backend::gpu::{Custom, Gpu};
-use crate::eval::num;
+use crate::json::{element_f32 as finite, num};
 use crate::kernels::Columns;
 
 /// A grid of texels, row-major (`texels[j·width + i]` is texel `(i, j)` covering
@@ -111,8 +111,8 @@ impl Grid {
             }
         }
         // The texels the core kernel reads: its (I0, I1) × (J0, J1).
-        let (i0, _, i1, _) = steradian_core::sat::axis(u0, u1, self.width);
-        let (j0, _, j1, _) = steradian_core::sat::axis(v0, v1, self.height);
+        let (i0, _, i1, _) = steradian_core::rsl::sat::axis(u0, u1, self.width);
+        let (j0, _, j1, _) = steradian_core::rsl::sat::axis(v0, v1, self.height);
         let mut abs_read = 0.0;
         for j in j0..=j1 {
             for i in i0..=i1 {
@@ -127,7 +127,7 @@ impl Grid {
     }
 }
 
-/// The error bound of `steradian_core::sat` (module docs):
+/// The error bound of `steradian_core::rsl::sat` (module docs):
 /// `2⁻²⁴·|I| + 2⁻¹⁵⁰ + 2⁻⁴⁶·A + n·2⁻⁵⁹·T`.
 pub fn error_bound(r: &BoxRef, abs_sum: f64) -> f64 {
     r.value.abs() * 2f64.powi(-24)
@@ -168,18 +168,6 @@ pub fn gpu_box_sums(
     gpu.run_custom(&custom, queries, out)
 }
 
-/// Parses a finite `f32` from JSON.
-fn finite(v: &Value, what: &str) -> Result<f32, String> {
-    let x = v
-        .as_f64()
-        .ok_or_else(|| format!("{what} must be a number, got {v}"))?;
-    let f = x as f32;
-    if !f.is_finite() {
-        return Err(format!("{what} = {x} is not a finite f32"));
-    }
-    Ok(f)
-}
-
 /// The grid of a `sat-box` line: an array of equally long, non-empty rows of finite
 /// numbers.
 pub fn parse_grid(v: &Value) -> Result<Grid, String> {
@@ -215,7 +203,7 @@ pub fn parse_grid(v: &Value) -> Result<Grid, String> {
 
 /// `steradian eval sat-box`: `{"grid": [[…], …], "queries": [[u0, v0, u1, v1], …]}` →
 /// `{"values": […]}`, the integrals over each box (texel units, corners in any order,
-/// clipped to the grid; see `steradian_core::sat`).
+/// clipped to the grid; see `steradian_core::rsl::sat`).
 pub fn eval_sat_box(obj: &Map<String, Value>) -> Result<Value, String> {
     let grid = parse_grid(obj.get("grid").ok_or("missing field \"grid\"")?)?;
     let queries = obj
@@ -564,7 +552,7 @@ pub mod options {
     }
 
     /// The core's table (`i64` fixed point, nine exact sub-sums).
-    pub struct Fixed(pub steradian_core::sat::Sat);
+    pub struct Fixed(pub steradian_core::rsl::sat::Sat);
 
     impl Storage for Fixed {
         fn name(&self) -> &'static str {

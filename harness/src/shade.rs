@@ -12,7 +12,7 @@
 //! ## The exact reference
 //!
 //! `B(x, wₒ) = ∫ L(ω)·ρ(ω, wₒ)·cos θ·V(x, ω) dω` with `L` the cube map (piecewise constant per
-//! texel, exact texel solid angles), `ρ·cos` the BRDF model ([`steradian_core::brdf`],
+//! texel, exact texel solid angles), `ρ·cos` the BRDF model ([`steradian_core::lobe::brdf`],
 //! evaluated at `f32`, accumulated in `f64`) and `V` exact ray–sphere visibility (`f64`).
 //! Every texel of every face is summed; each texel is split into `sub × sub` sub-texels
 //! with exact solid angles and `ρ·V` is taken at their centres, so `sub = 1` is the sum over
@@ -33,16 +33,16 @@
 use std::f64::consts::FRAC_1_SQRT_2;
 
 use glam::{DVec2, DVec3, Vec2, Vec3};
-use steradian_core::brdf::Brdf;
-use steradian_core::brdf_sat::{BrdfSat, FitOptions};
 use steradian_core::frame::Frame;
-use steradian_core::shade::{
+use steradian_core::lobe::brdf::Brdf;
+use steradian_core::rsl::brdf_sat::{BrdfSat, FitOptions};
+use steradian_core::rsl::shade::{
     self, Moments, ShadeLight, VdtQuery, VdtVisibility, multi_product_bound,
 };
-use steradian_core::vdt::Vdt;
-use steradian_core::vis_moments::VisMoments;
-use steradian_core::visibility::{Outside, binary_into, coverage_into, local_cap};
-use steradian_simd::shade::{
+use steradian_core::rsl::vdt::Vdt;
+use steradian_core::rsl::vis_moments::VisMoments;
+use steradian_core::rsl::visibility::{Outside, binary_into, coverage_into, local_cap};
+use steradian_simd::rsl::shade::{
     IsoBrdfTables, MomentsInput, ShadeInput, shade_batch, shade_moments_batch,
 };
 
@@ -346,7 +346,7 @@ fn exact_square(
                 sv += 1.0; // outside the disk counts as visible (Outside::Visible)
                 continue;
             }
-            let wi = steradian_core::hemisphere::unmap(q.as_vec2());
+            let wi = steradian_core::rsl::hemisphere::unmap(q.as_vec2());
             let d = (t * f64::from(wi.x) + b * f64::from(wi.y) + n * f64::from(wi.z)).normalize();
             let vis = p.visible(&scene.spheres, d) as u32 as f64;
             let rho = f64::from(brdf.eval(wi, wo));
@@ -680,7 +680,7 @@ pub fn fit_sat(brdf: &dyn Brdf, decs: &[&Decomposition], target: f32) -> BrdfSat
 
 /// The polar tables of an isotropic BRDF SAT as the SIMD and WGSL kernels read them
 /// (with [`BrdfSat::s_max`]). `None` for an anisotropic table.
-pub fn iso_views(sat: &BrdfSat) -> Option<Vec<steradian_core::sat::SatView<'_>>> {
+pub fn iso_views(sat: &BrdfSat) -> Option<Vec<steradian_core::rsl::sat::SatView<'_>>> {
     let res = sat.resolution();
     if res.azimuth != 1 {
         return None;
@@ -704,7 +704,7 @@ pub fn simd_inputs<'a>(scene: &Scene, vdts: &'a [Vdt]) -> Vec<ShadeInput<'a>> {
         .collect()
 }
 
-/// The SIMD kernel at every point (`steradian_simd::shade::shade_batch`).
+/// The SIMD kernel at every point (`steradian_simd::rsl::shade::shade_batch`).
 pub fn shade_points_simd(
     scene: &Scene,
     sat: &BrdfSat,
@@ -738,7 +738,7 @@ pub fn shade_points_moments(
         .collect()
 }
 
-/// The SIMD moments kernel at every point (`steradian_simd::shade::shade_moments_batch`).
+/// The SIMD moments kernel at every point (`steradian_simd::rsl::shade::shade_moments_batch`).
 /// `None` for an anisotropic BRDF SAT or moment tables of different sizes.
 pub fn shade_points_moments_simd(
     scene: &Scene,
@@ -772,7 +772,7 @@ pub fn shade_points_moments_simd(
 /// table as its exponent word and entries ([`push_sat_words`]).
 fn gpu_shade_prefix(
     sat: &BrdfSat,
-    views: &[steradian_core::sat::SatView<'_>],
+    views: &[steradian_core::rsl::sat::SatView<'_>],
     lights: &[ShadeLight],
     gradients: bool,
     map_n: usize,
@@ -816,9 +816,12 @@ fn gpu_shade_prefix(
 
 /// A summed-area table as the shading kernels read it: its exponent word, then its entries
 /// as `(low, high)` word pairs (`SatView::gpu_words` after its header).
-fn push_sat_words(w: &mut Vec<u32>, v: &steradian_core::sat::SatView<'_>) {
+fn push_sat_words(w: &mut Vec<u32>, v: &steradian_core::rsl::sat::SatView<'_>) {
     w.push(v.exponent() as u32);
-    w.extend(v.gpu_words().skip(steradian_core::sat::GPU_HEADER_WORDS));
+    w.extend(
+        v.gpu_words()
+            .skip(steradian_core::rsl::sat::GPU_HEADER_WORDS),
+    );
 }
 
 /// The binding-3 table of `wgsl::SHADE` (its layout is documented there), as `f32` bits.

@@ -9,13 +9,13 @@
 //! `r/√2`).
 
 use serde_json::{Map, Value, json};
-use steradian_core::cap::SphericalCap;
-use steradian_core::sat::Sat;
-use steradian_core::vdt::Vdt;
-use steradian_core::visibility::{self, Outside};
+use steradian_core::lobe::cap::SphericalCap;
+use steradian_core::rsl::sat::Sat;
+use steradian_core::rsl::vdt::Vdt;
+use steradian_core::rsl::visibility::{self, Outside};
 use steradian_core::{Vec2, Vec3};
 
-use crate::eval::num;
+use crate::json::num;
 use crate::rng::Rng;
 
 /// `±√d2` rounded to `f32` (`+` visible), or `±NO_BOUNDARY` for `d2 = ∞` (no boundary).
@@ -23,7 +23,7 @@ fn signed(d2: f64, visible: bool) -> f32 {
     let d = if d2.is_finite() {
         d2.sqrt() as f32
     } else {
-        steradian_core::vdt::NO_BOUNDARY
+        steradian_core::rsl::vdt::NO_BOUNDARY
     };
     if visible { d } else { -d }
 }
@@ -305,7 +305,7 @@ pub struct QueryResult {
     pub eq9: f32,
     /// Straight-edge (gradient) variant.
     pub gradient: f32,
-    /// Summed-area table of the binary map (4 lookups; `steradian_core::sat`).
+    /// Summed-area table of the binary map (4 lookups; `steradian_core::rsl::sat`).
     pub sat: f32,
     /// Exact visible fraction of the binary map.
     pub mask: f64,
@@ -408,7 +408,7 @@ fn map_queries(shape: &Shape, rng: &mut Rng, per_map: usize, out: &mut Vec<Query
         let (u, v) = (rng.range(hs, n as f64 - hs), rng.range(hs, n as f64 - hs));
         let (uf, vf, rf) = (u as f32, v as f32, r as f32);
         // The box of the f32 query, as the kernels see it.
-        let hsf = steradian_core::sat::square_half_side(rf) as f64;
+        let hsf = steradian_core::rsl::sat::square_half_side(rf) as f64;
         let (x0, y0, x1, y1) = (
             uf as f64 - hsf,
             vf as f64 - hsf,

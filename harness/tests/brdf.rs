@@ -5,8 +5,8 @@
 
 use std::f64::consts::{FRAC_PI_2, TAU};
 
-use steradian_core::brdf::{BlinnPhong, Brdf, Ggx, Lambert, Phong, Ward};
-use steradian_core::brdf_sat::{BrdfSat, FitOptions, Resolution};
+use steradian_core::lobe::brdf::{BlinnPhong, Brdf, Ggx, Lambert, Phong, Ward};
+use steradian_core::rsl::brdf_sat::{BrdfSat, FitOptions, Resolution};
 use steradian_core::{Vec2, Vec3};
 use steradian_harness::reference::brdf::{self as rb, Model};
 use steradian_harness::rng::Rng;
@@ -102,8 +102,8 @@ fn eval_matches_f64_formulas() {
         }
         // Sharp lobes amplify the rounding of the f32 inputs: `e·Δ(cos)` with Δ ≈ 1e-7.
         let a = b.feature_angle() as f64;
-        let bound = steradian_core::brdf::EVAL_REL_ERROR as f64
-            + steradian_core::brdf::EVAL_SHARPNESS_ERROR as f64 / (a * a);
+        let bound = steradian_core::lobe::brdf::EVAL_REL_ERROR as f64
+            + steradian_core::lobe::brdf::EVAL_SHARPNESS_ERROR as f64 / (a * a);
         println!(
             "{}: worst relative error {worst:.3e} (bound {bound:.1e})",
             b.name()
@@ -182,7 +182,7 @@ fn normal_incidence_phong_albedo_is_kd_plus_ks() {
 /// except Blinn–Phong's approximate normalisation (≤ `BLINN_PHONG_ALBEDO_BOUND`).
 #[test]
 fn energy_at_most_one() {
-    let bp = steradian_core::brdf::BLINN_PHONG_ALBEDO_BOUND as f64;
+    let bp = steradian_core::lobe::brdf::BLINN_PHONG_ALBEDO_BOUND as f64;
     let cases: Vec<(Pair, f64)> = vec![
         (pair(Lambert::new(1.0).unwrap()), 1.0),
         (pair(Phong::new(0.3, 0.7, 1.0).unwrap()), 1.0),
@@ -209,13 +209,13 @@ fn energy_at_most_one() {
     }
 }
 
-/// The measured albedo claims of `steradian_core::brdf`: Blinn–Phong's largest albedo over
+/// The measured albedo claims of `steradian_core::lobe::brdf`: Blinn–Phong's largest albedo over
 /// exponents and views up to 89° stays within `BLINN_PHONG_ALBEDO_BOUND` (1.075 at
 /// `e = 10`), and Ward's specular albedo falls towards grazing views, at most `½·ρ_s` at 89°
 /// for `α ≤ 1` (0.499 at `α = 0.5`).
 #[test]
 fn albedo_claims_blinn_phong_bound_and_ward_at_89_degrees() {
-    let bp = steradian_core::brdf::BLINN_PHONG_ALBEDO_BOUND as f64;
+    let bp = steradian_core::lobe::brdf::BLINN_PHONG_ALBEDO_BOUND as f64;
     for e in [0.0, 1.0, 3.0, 10.0, 30.0, 100.0, 1000.0] {
         let m = Model::from(BlinnPhong::new(0.0, 1.0, e as f32).unwrap());
         let w = (0..=30)

@@ -1,4 +1,4 @@
-//! The lobe-sum chain `∫ R·L·V` (steradian_core::lobe_sum) against f64 quadrature of the
+//! The lobe-sum chain `∫ R·L·V` (steradian_core::lobe::sum) against f64 quadrature of the
 //! exact integrand (reference::triple), on named hard cases and fixed-seed random scenes;
 //! threshold pruning (section 4.3) and its counters.
 //!
@@ -13,13 +13,13 @@
 //! this light could make the surface), so lights behind the surface do not divide by ~0.
 
 use glam::Vec3;
-use steradian_core::cap::{CapFit, SphericalCap};
 use steradian_core::frame::Frame;
-use steradian_core::lobe::{CosineLobe, Lafortune, LafortuneLobe, Phong};
-use steradian_core::lobe_sum::{
-    self, Cosine, LobeSum, LobeTerms, ProductCounts, lafortune_reflectance, phong_reflectance,
-    triple,
+use steradian_core::lobe::cap::{CapFit, SphericalCap};
+use steradian_core::lobe::sum::{
+    self as lobe_sum, Cosine, LobeSum, LobeTerms, ProductCounts, lafortune_reflectance,
+    phong_reflectance, triple,
 };
+use steradian_core::lobe::{CosineLobe, Lafortune, LafortuneLobe, Phong};
 use steradian_harness::reference::triple::{self as reference, Cap, Lobe, Scene, Term, Visibility};
 use steradian_harness::rng::Rng;
 

@@ -1,11 +1,11 @@
-//! The lobe-product kernel (`steradian_core::product`) against the exact f64 product
+//! The lobe-product kernel (`steradian_core::lobe::product`) against the exact f64 product
 //! integral: the error distribution over the whole domain on inputs the generator never
 //! saw, and the named hard cases of the issue.
 
 use std::f64::consts::{FRAC_PI_2, PI, TAU};
 
 use steradian_core::lobe::CosineLobe;
-use steradian_core::product::{
+use steradian_core::lobe::product::{
     self, INTEGRAL_REL_MAX, INTEGRAL_REL_MEAN, INTEGRAL_REL_P99, ProductFit, ProductTable,
 };
 use steradian_core::table::TableView;

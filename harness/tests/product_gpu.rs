@@ -4,7 +4,7 @@
 //! adapter is available unless `STERADIAN_REQUIRE_GPU=1`.
 
 use steradian_core::lobe::CosineLobe;
-use steradian_core::product::{self, ProductFit, ProductTable};
+use steradian_core::lobe::product::{self, ProductFit, ProductTable};
 use steradian_core::{Vec3, wgsl};
 use steradian_harness::backend::gpu::Gpu;
 use steradian_harness::backend::gpu_product::{

@@ -8,10 +8,10 @@ use proptest::test_runner::Config;
 
 #[path = "common/proptest_config.rs"]
 mod proptest_config;
-use steradian_core::cap::{self, CapFit, SphericalCap};
 use steradian_core::frame::Frame;
+use steradian_core::lobe::cap::{self, CapFit, SphericalCap};
 use steradian_core::lobe::{self, CosineLobe, Lafortune, LafortuneLobe, Phong};
-use steradian_core::{Vec2, Vec3, hemisphere};
+use steradian_core::{Vec2, Vec3, rsl::hemisphere};
 use steradian_harness::workload::{self, unit32};
 use steradian_harness::{accuracy, reference};
 

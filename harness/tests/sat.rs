@@ -1,4 +1,4 @@
-//! Summed-area tables: `steradian_core::sat` against the f64 brute-force sum (property tests
+//! Summed-area tables: `steradian_core::rsl::sat` against the f64 brute-force sum (property tests
 //! with a fixed seed, the stated bound `2⁻²⁴·|I| + 2⁻¹⁵⁰ + 2⁻⁴⁶·A + n·2⁻⁵⁹·T`), named hard cases,
 //! the SIMD kernel lane by lane (bit-exact), the WGSL kernel on a real adapter (within
 //! `wgsl::SAT_BOX_REL_TOL`; naga validation is in `wgsl_validate.rs`), and
@@ -11,7 +11,7 @@ use proptest::test_runner::Config;
 mod proptest_config;
 use serde_json::{Value, json};
 use steradian_core::Vec2;
-use steradian_core::sat::{Sat, SatView};
+use steradian_core::rsl::sat::{Sat, SatView};
 use steradian_core::wgsl;
 use steradian_harness::eval;
 use steradian_harness::kernels::Columns;
@@ -390,11 +390,11 @@ fn same(a: f32, b: f32) -> bool {
     a.to_bits() == b.to_bits() || (a.is_nan() && b.is_nan())
 }
 
-/// `steradian_simd::sat::box_sum_slices` over the boxes `qs`.
+/// `steradian_simd::rsl::sat::box_sum_slices` over the boxes `qs`.
 fn simd_box_sums(v: &SatView<'_>, qs: &[[f32; 4]]) -> Vec<f32> {
     let cols = Columns::from_rows(qs);
     let mut out = vec![0.0; qs.len()];
-    steradian_simd::sat::box_sum_slices(
+    steradian_simd::rsl::sat::box_sum_slices(
         v,
         cols.col(0),
         cols.col(1),
@@ -433,7 +433,7 @@ fn simd_matches_scalar_bit_for_bit() {
                 );
             }
             let rs: Vec<f32> = qs.iter().map(|q| q[2] - q[0]).collect();
-            steradian_simd::sat::square_slices(&v, cols.col(0), cols.col(1), &rs, &mut out);
+            steradian_simd::rsl::sat::square_slices(&v, cols.col(0), cols.col(1), &rs, &mut out);
             for (k, q) in qs.iter().enumerate() {
                 let want = v.square(Vec2::new(q[0], q[1]), rs[k]);
                 assert!(same(out[k], want), "square {w}×{h} lane {k}");

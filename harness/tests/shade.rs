@@ -15,10 +15,10 @@ use std::sync::OnceLock;
 use std::time::Instant;
 
 use steradian_core::Vec3;
-use steradian_core::brdf::{Brdf, Lambert, Phong};
-use steradian_core::brdf_sat::BrdfSat;
-use steradian_core::shade::{ShadeLight, VdtQuery};
-use steradian_core::vdt::Vdt;
+use steradian_core::lobe::brdf::{Brdf, Lambert, Phong};
+use steradian_core::rsl::brdf_sat::BrdfSat;
+use steradian_core::rsl::shade::{ShadeLight, VdtQuery};
+use steradian_core::rsl::vdt::Vdt;
 use steradian_harness::backend::gpu::Custom;
 use steradian_harness::env::decompose::{Decomposition, Options, PAPER_KS, decompose};
 use steradian_harness::env::{self, CubeMap};
@@ -333,12 +333,13 @@ fn kernel_matches_the_analysis_pipeline() {
     let scalar = sh::shade_points(&s.scene, &s.sat, &s.vdts, &s.lights, VdtQuery::Gradient);
     for (p, v) in scalar.iter().enumerate() {
         let pt = &s.scene.points[p];
-        let vis = steradian_core::shade::VdtVisibility::new(s.vdts[p].view(), VdtQuery::Gradient)
-            .unwrap();
+        let vis =
+            steradian_core::rsl::shade::VdtVisibility::new(s.vdts[p].view(), VdtQuery::Gradient)
+                .unwrap();
         let wo = pt.frame.to_local(pt.wo);
         let mut acc = [0.0f64; 3];
         for l in &s.lights {
-            let f = steradian_core::shade::light_factor(&pt.frame, wo, &s.sat, &vis, l);
+            let f = steradian_core::rsl::shade::light_factor(&pt.frame, wo, &s.sat, &vis, l);
             for c in 0..3 {
                 acc[c] += f64::from(l.energy()[c]) * f64::from(f);
             }
@@ -358,7 +359,7 @@ fn simd_matches_scalar_lane_by_lane() {
                 &format!("SIMD vs scalar (glossy {glossy}, {q:?})"),
                 &scalar,
                 &simd,
-                steradian_simd::shade::REL_TOL,
+                steradian_simd::rsl::shade::REL_TOL,
             );
         }
     }
@@ -381,7 +382,7 @@ fn simd_moments_matches_scalar_lane_by_lane() {
                 &format!("SIMD moments vs scalar (glossy {glossy}, {what})"),
                 &scalar,
                 &simd,
-                steradian_simd::shade::MOMENTS_REL_TOL,
+                steradian_simd::rsl::shade::MOMENTS_REL_TOL,
             );
         }
     }
@@ -392,7 +393,7 @@ fn simd_moments_matches_scalar_lane_by_lane() {
 /// different sides are refused.
 #[test]
 fn simd_moments_bad_lanes() {
-    use steradian_simd::shade::{IsoBrdfTables, MomentsInput, shade_moments_x8};
+    use steradian_simd::rsl::shade::{IsoBrdfTables, MomentsInput, shade_moments_x8};
     let s = small(false);
     let moments: Vec<_> = s.scene.points[..8]
         .iter()
@@ -412,7 +413,8 @@ fn simd_moments_bad_lanes() {
     pts[5].wo = -pts[5].frame.normal();
     let out = shade_moments_x8(&pts, &tables, &s.lights).unwrap();
     for (k, p) in pts.iter().enumerate() {
-        let want = steradian_core::shade::shade_moments(&p.frame, p.wo, &s.sat, &p.vis, &s.lights);
+        let want =
+            steradian_core::rsl::shade::shade_moments(&p.frame, p.wo, &s.sat, &p.vis, &s.lights);
         match k {
             3 => assert!(
                 out[k].iter().chain(&want).all(|x| x.is_nan()),
@@ -421,7 +423,7 @@ fn simd_moments_bad_lanes() {
             ),
             5 => assert_eq!((out[k], want), ([0.0; 3], [0.0; 3])),
             _ => assert!(
-                close(out[k], want, steradian_simd::shade::MOMENTS_REL_TOL) && want[0] > 0.0,
+                close(out[k], want, steradian_simd::rsl::shade::MOMENTS_REL_TOL) && want[0] > 0.0,
                 "lane {k}: {:?} vs {want:?}",
                 out[k]
             ),

@@ -14,10 +14,10 @@
 use std::time::Instant;
 
 use glam::{DVec3, Vec3};
-use steradian_core::brdf::{Brdf, Lambert, Phong};
 use steradian_core::frame::Frame;
-use steradian_core::shade::ShadeLight;
-use steradian_core::vis_moments::VisMoments;
+use steradian_core::lobe::brdf::{Brdf, Lambert, Phong};
+use steradian_core::rsl::shade::ShadeLight;
+use steradian_core::rsl::vis_moments::VisMoments;
 use steradian_core::wgsl::SHADE_MOMENTS_REL_TOL;
 use steradian_harness::env::decompose::{Decomposition, Options, decompose};
 use steradian_harness::env::{self};

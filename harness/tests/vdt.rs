@@ -10,10 +10,10 @@ use proptest::test_runner::Config;
 #[path = "common/proptest_config.rs"]
 mod proptest_config;
 use steradian_core::Vec3;
-use steradian_core::cap::SphericalCap;
 use steradian_core::frame::Frame;
-use steradian_core::vdt::{self, NO_BOUNDARY, Vdt, square_halfplane_fraction};
-use steradian_core::visibility::{self, Outside};
+use steradian_core::lobe::cap::SphericalCap;
+use steradian_core::rsl::vdt::{self, NO_BOUNDARY, Vdt, square_halfplane_fraction};
+use steradian_core::rsl::visibility::{self, Outside};
 use steradian_harness::rng::Rng;
 use steradian_harness::vdt::{
     Family, brute_force_edges, brute_force_squares, cap_area_in_hemisphere, caps_visible_area,
@@ -186,7 +186,7 @@ fn queries_on_axis_aligned_edges() {
             let r = rng.log_range(0.05, 20.0) as f32;
             let u = rng.range(0.5, w as f64 - 0.5) as f32;
             let y = rng.range(0.5, h as f64 - 0.5) as f32;
-            let hs = steradian_core::sat::square_half_side(r) as f64;
+            let hs = steradian_core::rsl::sat::square_half_side(r) as f64;
             let exact = ((u as f64 + hs - k as f64) / (2.0 * hs)).clamp(0.0, 1.0);
             let (e9, g) = v.query(u, y, r);
             assert!(

@@ -4,7 +4,7 @@
 //! Without an adapter the GPU test prints `GPU tests skipped: <reason>` and passes, unless
 //! `STERADIAN_REQUIRE_GPU=1`, in which case it fails.
 
-use steradian_core::vdt::Vdt;
+use steradian_core::rsl::vdt::Vdt;
 use steradian_core::wgsl;
 use steradian_harness::backend::gpu::Custom;
 use steradian_harness::kernels::Columns;
@@ -58,7 +58,10 @@ fn vdt_query_gpu_matches_scalar() {
         for (k, r) in rows.iter().enumerate() {
             let s = vdt.view().sample(r[0], r[1]);
             let (e9, gr) = vdt.query(r[0], r[1], r[2]);
-            let rr = r[2].clamp(steradian_core::vdt::R_MIN, steradian_core::vdt::R_MAX);
+            let rr = r[2].clamp(
+                steradian_core::rsl::vdt::R_MIN,
+                steradian_core::rsl::vdt::R_MAX,
+            );
             let t = (s.d as f64 * std::f64::consts::SQRT_2 / rr as f64).abs();
             for (got, want, what) in [(out.data[k], e9, "eq9"), (out.data[n + k], gr, "gradient")] {
                 let err = (got as f64 - want as f64).abs() / (1.0 + t);

@@ -3,7 +3,7 @@
 //! the core needs neither std nor alloc.
 #![no_std]
 
-use steradian_core::{Vec3, cap, hemisphere, lobe};
+use steradian_core::{Vec3, lobe, lobe::cap, rsl::hemisphere};
 
 /// Runs one kernel of each kind without std: map a direction, evaluate a lobe, fit a cap.
 pub fn smoke() -> f32 {

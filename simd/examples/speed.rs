@@ -21,7 +21,7 @@
 use std::hint::black_box;
 use std::time::Instant;
 
-use steradian_core::{Vec2, Vec3, cap, hemisphere, lobe};
+use steradian_core::{Vec2, Vec3, lobe, lobe::cap, rsl::hemisphere};
 use steradian_simd as simd;
 
 #[derive(Clone, Copy, PartialEq, Eq)]
@@ -114,12 +114,12 @@ fn run_simd(k: K, input: &[f32], n: usize, out: &mut [f32]) {
     match k {
         K::Map => {
             let (u, v) = out.split_at_mut(n);
-            simd::hemisphere::map_slices(col(0), col(1), col(2), u, v);
+            simd::rsl::hemisphere::map_slices(col(0), col(1), col(2), u, v);
         }
         K::Unmap => {
             let (x, rest) = out.split_at_mut(n);
             let (y, z) = rest.split_at_mut(n);
-            simd::hemisphere::unmap_slices(col(0), col(1), x, y, z);
+            simd::rsl::hemisphere::unmap_slices(col(0), col(1), x, y, z);
         }
         K::Eval => simd::lobe::eval_slices(
             [col(0), col(1), col(2)],
@@ -129,7 +129,7 @@ fn run_simd(k: K, input: &[f32], n: usize, out: &mut [f32]) {
             out,
         ),
         K::Integral => simd::lobe::integral_slices(col(0), col(1), out),
-        K::Cap => simd::cap::exponent_l2_slices(col(0), out),
+        K::Cap => simd::lobe::cap::exponent_l2_slices(col(0), out),
     }
 }
 

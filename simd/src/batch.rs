@@ -413,18 +413,6 @@ impl LobeX8 {
             load8_padded(exponent, offset, Self::PAD_EXPONENT),
         )
     }
-
-    /// [`crate::lobe::eval`] of this batch.
-    #[inline]
-    pub fn eval(self, v: Vec3x8) -> f32x8 {
-        crate::lobe::eval(self, v)
-    }
-
-    /// [`crate::lobe::integral`] of this batch.
-    #[inline]
-    pub fn integral(self) -> f32x8 {
-        crate::lobe::integral(self.exponent, self.scale)
-    }
 }
 
 impl From<[CosineLobe; LANES]> for LobeX8 {

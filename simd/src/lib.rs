@@ -72,17 +72,13 @@
 //! `cargo run --release -p steradian-simd --example speed` prints ns per element for the
 //! scalar kernel called per input behind `black_box`, a plain loop over the scalar kernel
 //! (which LLVM auto-vectorises where it can), and the slice functions.
+#![cfg_attr(not(test), no_std)]
 #![forbid(unsafe_code)]
 #![warn(missing_docs)]
 
 pub mod batch;
-pub mod cap;
-pub mod hemisphere;
 pub mod lobe;
-pub mod product;
-pub mod sat;
-pub mod shade;
-pub mod vdt;
+pub mod rsl;
 
 mod lanes;
 

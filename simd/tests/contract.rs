@@ -6,7 +6,7 @@
 
 use glam::{Vec2, Vec3};
 use steradian_core as core_;
-use steradian_simd::{LobeX8, Vec2x8, Vec3x8, cap, f32x8, hemisphere, lobe};
+use steradian_simd::{LobeX8, Vec2x8, Vec3x8, f32x8, lobe, lobe::cap, rsl::hemisphere};
 
 // ---------------------------------------------------------------------------------------
 // Inputs
@@ -60,7 +60,7 @@ fn check_map(rows: &[Vec3]) {
     let (mut u, mut v) = (vec![f32::NAN; n], vec![f32::NAN; n]);
     hemisphere::map_slices(&x, &y, &z, &mut u, &mut v);
     for (i, d) in rows.iter().enumerate() {
-        let p = core_::hemisphere::map(*d);
+        let p = core_::rsl::hemisphere::map(*d);
         assert!(
             same(p.x, u[i]) && same(p.y, v[i]),
             "map({d:?}) [row {i}]: scalar {p:?} simd ({}, {})",
@@ -72,7 +72,7 @@ fn check_map(rows: &[Vec3]) {
     for (k, chunk) in rows.chunks(8).enumerate() {
         let out = hemisphere::map(Vec3x8::from_slice(chunk)).to_array();
         for (j, d) in chunk.iter().enumerate() {
-            let p = core_::hemisphere::map(*d);
+            let p = core_::rsl::hemisphere::map(*d);
             assert!(
                 same(p.x, out[j].x) && same(p.y, out[j].y),
                 "batch map({d:?}) [row {}]",
@@ -89,7 +89,7 @@ fn check_unmap(rows: &[Vec2]) {
     let (mut x, mut y, mut z) = (vec![f32::NAN; n], vec![f32::NAN; n], vec![f32::NAN; n]);
     hemisphere::unmap_slices(&u, &v, &mut x, &mut y, &mut z);
     for (i, p) in rows.iter().enumerate() {
-        let d = core_::hemisphere::unmap(*p);
+        let d = core_::rsl::hemisphere::unmap(*p);
         assert!(
             same(d.x, x[i]) && same(d.y, y[i]) && same(d.z, z[i]),
             "unmap({p:?}) [row {i}]: scalar {d:?} simd ({}, {}, {})",
@@ -101,7 +101,7 @@ fn check_unmap(rows: &[Vec2]) {
     for chunk in rows.chunks(8) {
         let out = hemisphere::unmap(Vec2x8::from_slice(chunk)).to_array();
         for (j, p) in chunk.iter().enumerate() {
-            let d = core_::hemisphere::unmap(*p);
+            let d = core_::rsl::hemisphere::unmap(*p);
             assert!(same(d.x, out[j].x) && same(d.y, out[j].y) && same(d.z, out[j].z));
         }
     }
@@ -128,7 +128,7 @@ fn check_cap(rows: &[f32]) {
     let mut out = vec![f32::NAN; rows.len()];
     cap::exponent_l2_slices(rows, &mut out);
     for (i, &a) in rows.iter().enumerate() {
-        let c = core_::cap::exponent_l2(a);
+        let c = core_::lobe::cap::exponent_l2(a);
         assert!(
             same(c, out[i]),
             "exponent_l2({a:e}) [row {i}]: scalar {c:e} simd {:e}",
@@ -378,13 +378,13 @@ fn special_half_angles() -> Vec<f32> {
         2.0,
         -1.0,
         -1e-4,
-        core_::cap::MIN_HALF_ANGLE,
-        core_::cap::MIN_HALF_ANGLE.next_down(),
+        core_::lobe::cap::MIN_HALF_ANGLE,
+        core_::lobe::cap::MIN_HALF_ANGLE.next_down(),
         1e-19,
     ];
     // every grid node (uniform in x = 1 − sqrt(1 − α/(π/2))) and its neighbours
-    let last = (core_::cap::TABLE_LEN - 1) as f64;
-    for i in 0..core_::cap::TABLE_LEN {
+    let last = (core_::lobe::cap::TABLE_LEN - 1) as f64;
+    for i in 0..core_::lobe::cap::TABLE_LEN {
         let w = 1.0 - i as f64 / last;
         let a = ((1.0 - w * w) * std::f64::consts::FRAC_PI_2) as f32;
         rows.extend([a.next_down(), a, a.next_up()]);
@@ -429,7 +429,7 @@ fn cap_custom_tables() {
         let mut out = vec![0.0; angles.len()];
         cap::lookup_slices(&table, &angles, &mut out);
         for (a, w) in angles.iter().zip(&out) {
-            let c = core_::cap::lookup(&table, *a);
+            let c = core_::lobe::cap::lookup(&table, *a);
             assert!(same(c, *w), "lookup(len {len}, {a:e}): {c:e} vs {w:e}");
         }
     }
@@ -448,7 +448,7 @@ fn cap_exhaustive() {
         }
         cap::exponent_l2_slices(&a, &mut out);
         for (x, w) in a.iter().zip(&out) {
-            let c = core_::cap::exponent_l2(*x);
+            let c = core_::lobe::cap::exponent_l2(*x);
             assert!(same(c, *w), "exponent_l2({x:e}): {c:e} vs {w:e}");
         }
     }
@@ -775,11 +775,12 @@ fn columns_layout_like_the_backend() {
                 let got = |c: usize| out[c * n + r];
                 match kernel {
                     "hemisphere-map" => {
-                        let p = core_::hemisphere::map(Vec3::new(at(0, r), at(1, r), at(2, r)));
+                        let p =
+                            core_::rsl::hemisphere::map(Vec3::new(at(0, r), at(1, r), at(2, r)));
                         assert!(same(p.x, got(0)) && same(p.y, got(1)));
                     }
                     "hemisphere-unmap" => {
-                        let d = core_::hemisphere::unmap(Vec2::new(at(0, r), at(1, r)));
+                        let d = core_::rsl::hemisphere::unmap(Vec2::new(at(0, r), at(1, r)));
                         assert!(same(d.x, got(0)) && same(d.y, got(1)) && same(d.z, got(2)));
                     }
                     "lobe-eval" => {
@@ -796,7 +797,7 @@ fn columns_layout_like_the_backend() {
                     "lobe-integral" => {
                         assert!(same(core_::lobe::integral(at(0, r), at(1, r)), got(0)));
                     }
-                    _ => assert!(same(core_::cap::exponent_l2(at(0, r)), got(0))),
+                    _ => assert!(same(core_::lobe::cap::exponent_l2(at(0, r)), got(0))),
                 }
             }
         }

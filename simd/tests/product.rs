@@ -1,5 +1,5 @@
-//! The lobe product of `steradian_simd::product` against the scalar kernel
-//! `steradian_core::product::product_with`, lane by lane: the axis bit-identical, the scale,
+//! The lobe product of `steradian_simd::lobe::product` against the scalar kernel
+//! `steradian_core::lobe::product::product_with`, lane by lane: the axis bit-identical, the scale,
 //! exponent and integral within the bounds of the module docs, non-finite and extreme
 //! lanes (recomputed by the scalar kernel) bit-identical. Inputs: deterministic
 //! pseudo-random lobes over the whole domain, named hard cases in every lane position,
@@ -7,8 +7,8 @@
 
 use glam::Vec3;
 use steradian_core::lobe::CosineLobe;
-use steradian_core::product::{self as core_product, ProductFit, ProductTable};
-use steradian_simd::product::{
+use steradian_core::lobe::product::{self as core_product, ProductFit, ProductTable};
+use steradian_simd::lobe::product::{
     EXPONENT_REL_TOL, INTEGRAL_REL_TOL, MAX_WIDE_EXPONENT, SCALE_REL_TOL, UNDERFLOW_ABS,
     product_slices, product_x8,
 };

@@ -3,7 +3,7 @@
 
 use std::hint::black_box;
 
-use steradian_core::{Vec2, Vec3, cap, hemisphere, lobe};
+use steradian_core::{Vec2, Vec3, lobe, lobe::cap, rsl::hemisphere};
 
 use super::{Backend, BackendError, check_shapes};
 use crate::kernels::{Columns, Kernel};

@@ -260,7 +260,7 @@ impl Gpu {
                 usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
                 mapped_at_creation: false,
             });
-            let bytes: &[u8] = bytemuck::cast_slice(&steradian_core::cap::TABLE[..]);
+            let bytes: &[u8] = bytemuck::cast_slice(&steradian_core::lobe::cap::TABLE[..]);
             let table = device.create_buffer(&wgpu::BufferDescriptor {
                 label: Some("steradian cap-exponent table"),
                 size: bytes.len() as u64,

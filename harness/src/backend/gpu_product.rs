@@ -7,7 +7,7 @@
 //! read-back). [`ProductGpuTable`] decodes a table once for repeated runs.
 
 use steradian_core::lobe::CosineLobe;
-use steradian_core::product::{self, ProductTable};
+use steradian_core::lobe::product::{self, ProductTable};
 use steradian_core::table::TableView;
 use steradian_core::{Vec3, wgsl};
 

@@ -8,7 +8,7 @@
 //! `steradian_simd::lobe::EVAL_REL_TOL·(1 + |ln(c/s)|)` relative of the scalar kernel, and
 //! zero and NaN exactly where it is (see the crate docs of `steradian-simd`).
 
-use steradian_simd::{cap, hemisphere, lobe};
+use steradian_simd::{lobe, lobe::cap, rsl::hemisphere};
 
 use super::{Backend, BackendError, check_shapes};
 use crate::kernels::{Columns, Kernel};

@@ -79,7 +79,7 @@
 //! The paper's light is uniform over its square. Each region also gets a radiance gradient
 //! per channel for the linear model `L(ω) = E/Ω + G·(ω − c)` over the square
 //! ([`steradian_core::rsl::Rsl::gradient`], read only by the moments kernel,
-//! [`steradian_core::shade::light_moments`]). `G` is not a least-squares fit over the
+//! [`steradian_core::rsl::shade::light_moments`]). `G` is not a least-squares fit over the
 //! region: the square is centred where the fit put it (often the region's luminance
 //! centroid) and has the square's extent, not the region's, so a least-squares gradient
 //! moves the light's energy centroid a second time and overshoots across narrow regions

@@ -2,11 +2,11 @@
 //! `x_i = i/(N − 1)`, with `h(0) = 2k*` (the small-cap limit) and `h(π/2) = 0`. The grid
 //! is uniform in `x` and dense near `π/2`, where `e*` behaves like `c·(1 − ln c)/2`
 //! (`c = cos α`) and a grid uniform in `α` would need ~4000 samples. See
-//! `steradian_core::cap`.
+//! `steradian_core::lobe::cap`.
 
 use std::f64::consts::FRAC_PI_2;
 
-use steradian_core::cap::{TABLE_LEN, TABLE_NAME};
+use steradian_core::lobe::cap::{TABLE_LEN, TABLE_NAME};
 use steradian_core::table::{HEADER_LEN, Spec, encode_into};
 
 use crate::reference::cap::h;

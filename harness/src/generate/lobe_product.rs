@@ -1,4 +1,4 @@
-//! The lobe-product table: `g = ln I − ln B` (see `steradian_core::product`) at
+//! The lobe-product table: `g = ln I − ln B` (see `steradian_core::lobe::product`) at
 //! `exponents × exponents × angles` nodes, symmetric in the exponents and stored once as a
 //! packed triangle. `I` is the exact f64 product integral
 //! (`reference::product::ln_product_integral`), `B` the kernel's closed-form baseline
@@ -8,7 +8,7 @@
 
 use std::f64::consts::{PI, TAU};
 
-use steradian_core::product::{
+use steradian_core::lobe::product::{
     ANGLE_LOG_DROP, EXPONENT_EPS, EXPONENT_MAX, TABLE_ANGLES, TABLE_EXPONENTS, TABLE_NAME,
 };
 use steradian_core::table::{HEADER_LEN, Spec, encode_into};
@@ -63,7 +63,7 @@ fn ln_cos_half(omc: f64, opc: f64) -> f64 {
     }
 }
 
-/// `(ln B, w)` of the kernel's baseline in f64 (`steradian_core::product::baseline`).
+/// `(ln B, w)` of the kernel's baseline in f64 (`steradian_core::lobe::product::baseline`).
 pub fn baseline(e1: f64, e2: f64, alpha: f64) -> (f64, f64) {
     let (s, c) = (libm::sin(alpha), libm::cos(alpha));
     let (f1, f2) = (e1 + 1.0, e2 + 1.0);
@@ -116,7 +116,7 @@ pub fn node_angle(e1: f64, e2: f64, target: f64) -> f64 {
 }
 
 /// The `g` values of a table with `exponents × angles` samples (packed triangle, see
-/// `steradian_core::product::ProductTable`). Calls `progress` after each exponent pair.
+/// `steradian_core::lobe::product::ProductTable`). Calls `progress` after each exponent pair.
 pub fn values(exponents: usize, angles: usize, progress: &dyn Fn(usize, usize)) -> Vec<f32> {
     let pairs = exponents * (exponents + 1) / 2;
     let mut out = vec![0f32; pairs * angles];

@@ -1,6 +1,6 @@
 //! Table generators. Each built-in table of `steradian-core` is produced here in f64 from
 //! its exact definition, encoded with `steradian_core::table`, and committed under
-//! `core/src/tables/`. `steradian tables` rewrites them; `steradian tables --check`
+//! `core/src/lobe/tables/`. `steradian tables` rewrites them; `steradian tables --check`
 //! regenerates in memory and fails if a committed file differs.
 
 pub mod cap_exponent;
@@ -8,7 +8,7 @@ pub mod lobe_product;
 
 use std::path::{Path, PathBuf};
 
-/// A built-in table: its file name under `core/src/tables/` and its generator.
+/// A built-in table: its file name under `core/src/lobe/tables/` and its generator.
 pub struct TableDef {
     /// File name, e.g. `cap_exponent.bin`.
     pub file: &'static str,
@@ -32,9 +32,9 @@ pub const TABLES: &[TableDef] = &[
     },
 ];
 
-/// `core/src/tables` of this source tree.
+/// `core/src/lobe/tables` of this source tree.
 pub fn default_dir() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("../core/src/tables")
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../core/src/lobe/tables")
 }
 
 /// Outcome of writing or checking one table.

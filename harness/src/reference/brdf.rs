@@ -1,5 +1,5 @@
-//! `f64` references for the BRDF models of `steradian_core::brdf` and their integrals over
-//! squares of the equal-area parametrisation (`steradian_core::brdf_sat`).
+//! `f64` references for the BRDF models of `steradian_core::lobe::brdf` and their integrals over
+//! squares of the equal-area parametrisation (`steradian_core::rsl::brdf_sat`).
 //!
 //! The models are written again here in their textbook form (normalised half vector,
 //! `powf`, `tan²θ_h`, `G₁` as a ratio), independently of the rearranged `f32` forms in core,
@@ -12,7 +12,7 @@
 
 use std::f64::consts::{FRAC_1_SQRT_2, PI};
 
-use steradian_core::brdf::{self, Brdf};
+use steradian_core::lobe::brdf::{self, Brdf};
 
 /// A BRDF model with `f64` parameters.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -329,7 +329,7 @@ pub fn albedo(model: &Model, wo: [f64; 3], tol: f64) -> f64 {
     Adaptive { f, force }.run([0.0, 0.0, 1.0, 2.0 * PI], 8, tol)
 }
 
-/// The error metric of `steradian_core::brdf_sat`: `|got − exact| / max(exact, A·4r²/(2π))`
+/// The error metric of `steradian_core::rsl::brdf_sat`: `|got − exact| / max(exact, A·4r²/(2π))`
 /// with `A` the directional albedo.
 pub fn table_error(got: f64, exact: f64, albedo: f64, r: f64) -> f64 {
     let floor = albedo * 4.0 * r * r / (2.0 * PI);

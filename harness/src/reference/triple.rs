@@ -42,9 +42,9 @@
 use std::f64::consts::{FRAC_PI_2, PI, TAU};
 
 use super::quad::gk15;
-use steradian_core::cap::SphericalCap;
 use steradian_core::lobe::CosineLobe;
-use steradian_core::lobe_sum::LobeTerms;
+use steradian_core::lobe::cap::SphericalCap;
+use steradian_core::lobe::sum::LobeTerms;
 
 /// A direction in f64.
 pub type V3 = [f64; 3];

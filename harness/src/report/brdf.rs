@@ -1,4 +1,4 @@
-//! Report section: BRDF summed-area tables (`steradian_core::brdf_sat`). Per BRDF model, the
+//! Report section: BRDF summed-area tables (`steradian_core::rsl::brdf_sat`). Per BRDF model, the
 //! resolution [`BrdfSat::fit`] chose for a modest target, the bytes, the achieved error on
 //! its test set, the error on fresh queries against the `f64` reference, the fit (build)
 //! time, and the query throughput against the baseline measured in the same run: a 4×4
@@ -12,9 +12,9 @@ use std::time::{Duration, Instant};
 
 use indicatif::{ProgressBar, ProgressStyle};
 use serde_json::json;
-use steradian_core::brdf::{BlinnPhong, Brdf, Ggx, Lambert, Phong, Ward};
-use steradian_core::brdf_sat::{BrdfSat, FitOptions};
-use steradian_core::{Vec2, Vec3, hemisphere};
+use steradian_core::lobe::brdf::{BlinnPhong, Brdf, Ggx, Lambert, Phong, Ward};
+use steradian_core::rsl::brdf_sat::{BrdfSat, FitOptions};
+use steradian_core::{Vec2, Vec3, rsl::hemisphere};
 
 use super::Options;
 use super::sections::Section;

@@ -1,5 +1,5 @@
 //! Report section "lobe-sum": the rendering integral `∫ R·L·V` as a chain of lobe products
-//! (`steradian_core::lobe_sum::triple`) on a Figure-16-like scene of the cosine-lobe paper —
+//! (`steradian_core::lobe::sum::triple`) on a Figure-16-like scene of the cosine-lobe paper —
 //! shaded points on a plane, one spherical light, a cluster of sphere occluders, a glossy
 //! Phong material — for a range of pruning thresholds `t` (section 4.3): error against f64
 //! quadrature together with the number of products computed and the time per point, i.e.
@@ -19,12 +19,12 @@ use std::time::Instant;
 use indicatif::{ProgressBar, ProgressStyle};
 use serde_json::json;
 use steradian_core::Vec3;
-use steradian_core::cap::{CapFit, SphericalCap};
-use steradian_core::lobe::{CosineLobe, Phong};
-use steradian_core::lobe_sum::{
+use steradian_core::lobe::cap::{CapFit, SphericalCap};
+use steradian_core::lobe::product::{self, ProductFit, ProductTable};
+use steradian_core::lobe::sum::{
     Cosine, LobeSum, ProductCounts, light_with_cosine, phong_reflectance, triple_with,
 };
-use steradian_core::product::{self, ProductFit, ProductTable};
+use steradian_core::lobe::{CosineLobe, Phong};
 
 use super::Options;
 use super::plot::{Pt, Scale, Series, chart};

@@ -12,7 +12,7 @@ use std::time::{Duration, Instant};
 use indicatif::{ProgressBar, ProgressStyle};
 use serde_json::json;
 use steradian_core::lobe::CosineLobe;
-use steradian_core::product::{self, ProductFit, ProductTable};
+use steradian_core::lobe::product::{self, ProductFit, ProductTable};
 
 use super::Options;
 use super::plot::{Pt, Scale, Series, chart};
@@ -181,7 +181,7 @@ fn batch_speeds(
         let t = Instant::now();
         {
             let [o0, o1, o2, o3, o4] = &mut out;
-            steradian_simd::product::product_slices(
+            steradian_simd::lobe::product::product_slices(
                 &table,
                 ProductFit::ExactIntegral,
                 [&a_axis[0], &a_axis[1], &a_axis[2]],

@@ -1,6 +1,6 @@
 //! Report section: summed-area tables. Error against the f64 brute force for every storage
 //! option measured (plain `f32`, mean subtracted, `f32` with an `f64` offset per tile, hi/lo
-//! `f32` pairs, `f64`, and the `i64` fixed point of `steradian_core::sat`) at 64² … 2048²,
+//! `f32` pairs, `f64`, and the `i64` fixed point of `steradian_core::rsl::sat`) at 64² … 2048²,
 //! bytes per option, build time and query throughput (scalar, SIMD, wgpu) with the
 //! baselines measured in the same run.
 
@@ -11,7 +11,7 @@ use std::time::{Duration, Instant};
 
 use indicatif::{ProgressBar, ProgressStyle};
 use serde_json::json;
-use steradian_core::sat::Sat;
+use steradian_core::rsl::sat::Sat;
 
 use super::Options;
 use super::sections::Section;
@@ -241,7 +241,7 @@ pub fn section(opts: &Options) -> Result<Section, Box<dyn Error>> {
     let scalar_out = out.clone();
     let mut simd_out = vec![0.0f32; QUERIES];
     let t_simd = time(|| {
-        steradian_simd::sat::box_sum_slices(
+        steradian_simd::rsl::sat::box_sum_slices(
             &view,
             cols.col(0),
             cols.col(1),
@@ -298,7 +298,7 @@ pub fn section(opts: &Options) -> Result<Section, Box<dyn Error>> {
     });
     let t_warm_simd = time(|| {
         for _ in 0..reps {
-            steradian_simd::sat::box_sum_slices(
+            steradian_simd::rsl::sat::box_sum_slices(
                 &view,
                 wc.col(0),
                 wc.col(1),
@@ -475,7 +475,7 @@ pub fn section(opts: &Options) -> Result<Section, Box<dyn Error>> {
         "<p>Texels uniform in [0, 1); {ERROR_BOXES} random boxes with fractional corners \
          (sides 0.5–64 texels) per resolution plus the 16×16 integer box next to the far corner; \
          error = |box − exact| in f32 ulps of the exact box integral (f64 brute force). \
-         Bound of <code>steradian_core::sat</code>: |err| ≤ 2⁻²⁴·|I| + 2⁻¹⁵⁰ + 2⁻⁴⁶·A + n·2⁻⁵⁹·T.</p>\
+         Bound of <code>steradian_core::rsl::sat</code>: |err| ≤ 2⁻²⁴·|I| + 2⁻¹⁵⁰ + 2⁻⁴⁶·A + n·2⁻⁵⁹·T.</p>\
          <table><tr><th>option</th><th>bytes/texel (1024²)</th>"
     );
     for s in SIDES {

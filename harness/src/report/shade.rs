@@ -10,8 +10,8 @@ use std::time::{Duration, Instant};
 
 use indicatif::{ProgressBar, ProgressStyle};
 use serde_json::json;
-use steradian_core::brdf::Lambert;
-use steradian_core::shade::{self, ShadeLight, VdtQuery, VdtVisibility};
+use steradian_core::lobe::brdf::Lambert;
+use steradian_core::rsl::shade::{self, ShadeLight, VdtQuery, VdtVisibility};
 
 use super::Options;
 use super::sections::Section;

@@ -12,8 +12,8 @@ use std::time::Duration;
 
 use indicatif::{ProgressBar, ProgressStyle};
 use serde_json::json;
-use steradian_core::sat::Sat;
-use steradian_core::vdt::{Vdt, scratch_len, signed_distance_into};
+use steradian_core::rsl::sat::Sat;
+use steradian_core::rsl::vdt::{Vdt, scratch_len, signed_distance_into};
 use steradian_core::{Vec2, wgsl};
 
 use super::Options;
@@ -64,7 +64,7 @@ fn query_speed(
         black_box(&a);
     });
     let simd = time(|| {
-        steradian_simd::vdt::query_slices(&view, &u, &v, &r, &mut a, &mut b);
+        steradian_simd::rsl::vdt::query_slices(&view, &u, &v, &r, &mut a, &mut b);
         black_box(&a);
     });
     let sat_t = time(|| {

@@ -1,7 +1,7 @@
-//! Equal-area hemisphere map, 8 lanes at a time (mirrors `steradian_core::hemisphere`).
+//! Equal-area hemisphere map, 8 lanes at a time (mirrors `steradian_core::rsl::hemisphere`).
 //!
 //! [`map`] and [`unmap`] perform exactly the scalar kernels' IEEE operations in the same
-//! order, so every lane is **bit-identical** to `steradian_core::hemisphere::map`/`unmap` of
+//! order, so every lane is **bit-identical** to `steradian_core::rsl::hemisphere::map`/`unmap` of
 //! that lane, for every input (NaN-ness matches, payloads may differ). That includes the
 //! scalar kernels' saturation: the zero vector maps to the pole, the reciprocal `1/m` of the
 //! largest component is clamped to the normal range, `z → |z|`, points outside the disk are
@@ -13,7 +13,7 @@
 use crate::batch::{PAD_VEC2, PAD_VEC3, Vec2x8, Vec3x8};
 use crate::lanes::{ColumnKernel, Lanes, SliceVec, clamp, drive, max_num};
 
-/// Direction → point on the unit disk, lane-wise `steradian_core::hemisphere::map`:
+/// Direction → point on the unit disk, lane-wise `steradian_core::rsl::hemisphere::map`:
 /// `p = (x, y)/sqrt(1 + |z|)` of the normalised input, the zero vector → `0`.
 #[inline]
 pub fn map(dir: Vec3x8) -> Vec2x8 {
@@ -22,7 +22,7 @@ pub fn map(dir: Vec3x8) -> Vec2x8 {
 }
 
 /// Point on the disk → unit direction in the upper hemisphere, lane-wise
-/// `steradian_core::hemisphere::unmap`: `z = 1 − |p|²`, `(x, y) = p·sqrt(2 − |p|²)`, points
+/// `steradian_core::rsl::hemisphere::unmap`: `z = 1 − |p|²`, `(x, y) = p·sqrt(2 − |p|²)`, points
 /// outside the disk clamped radially onto the circle.
 #[inline]
 pub fn unmap(p: Vec2x8) -> Vec3x8 {

@@ -1,7 +1,7 @@
 //! Visibility distance table queries, 8 (or 16) lanes at a time (mirrors
-//! `steradian_core::vdt`).
+//! `steradian_core::rsl::vdt`).
 //!
-//! [`query`] performs exactly the operations of `steradian_core::vdt::VdtView::query` lane
+//! [`query`] performs exactly the operations of `steradian_core::rsl::vdt::VdtView::query` lane
 //! by lane: the clamped cell index and fraction per axis (`floor` written as `−ceil(−x)`,
 //! which is exact), the four samples, `lerp(a, b, t) = (1 − t)·a + t·b`, the in-cell
 //! gradient, eq. 9 and the straight-edge fraction with the scalar kernel's NaN-keeping
@@ -10,7 +10,7 @@
 //! scalar query of that lane, for every input (NaN-ness matches). `wide` has no gather: the
 //! four samples of each lane are read by scalar indexing from the lanes' cell indices.
 
-use steradian_core::vdt::{Q_MIN, R_MAX, R_MIN, VdtView};
+use steradian_core::rsl::vdt::{Q_MIN, R_MAX, R_MIN, VdtView};
 use wide::f32x8;
 
 use crate::lanes::{ColumnKernel, Lanes, SliceVec, clamp, drive, max_num, min_num};
@@ -131,7 +131,7 @@ pub fn query_slices(
 mod tests {
     use super::*;
     use crate::lanes::tests::same;
-    use steradian_core::vdt::{scratch_len, signed_distance_into};
+    use steradian_core::rsl::vdt::{scratch_len, signed_distance_into};
 
     /// The exact table of a mask (the crate has no `alloc` feature of core).
     fn table(w: usize, h: usize, mask: &[bool]) -> Vec<f32> {

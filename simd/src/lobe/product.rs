@@ -1,8 +1,8 @@
 //! Products of two cosine lobes as one lobe, 8 (or 16) lanes at a time (mirrors
-//! `steradian_core::product`; see it for the formulas, their source in the cosine-lobe
+//! `steradian_core::lobe::product`; see it for the formulas, their source in the cosine-lobe
 //! paper, section 4.1, and the table).
 //!
-//! Lane `k` of [`product_x8`] is `steradian_core::product::product_with(table, fit, a_k,
+//! Lane `k` of [`product_x8`] is `steradian_core::lobe::product::product_with(table, fit, a_k,
 //! b_k)` with `a_k`, `b_k` lane `k` of the inputs as [`LobeX8::to_array`] builds them
 //! (`CosineLobe::saturating`: the axis normalised, a zero axis replaced by `+z`, a negative
 //! exponent clamped to 0). The kernel performs the scalar kernel's operations in the same
@@ -28,7 +28,7 @@
 //!   `ExactIntegralCurvature`, whose scale is `exp(ln I)·(1 + e_r)/2π`) matters only where a
 //!   subnormal intermediate is rounded onto the subnormal grid on both sides. Where `|ln I|
 //!   < 20` the measured relative integral difference is below `6e-6`, far below the table's
-//!   own error against the exact integral (`steradian_core::product::INTEGRAL_REL_MEAN`);
+//!   own error against the exact integral (`steradian_core::lobe::product::INTEGRAL_REL_MEAN`);
 //!   a result within the tolerance of `f32::MAX` may overflow to `±∞` on one side only.
 //!
 //! **Lanes recomputed by the scalar kernel** (bit-identical): a lane with a non-finite
@@ -59,12 +59,18 @@
 use core::f32::consts::TAU;
 
 use steradian_core::lobe::CosineLobe;
-use steradian_core::product::{
+use steradian_core::lobe::product::{
     ANGLE_LOG_DROP, EXPONENT_EPS, ProductFit, ProductTable, product_with,
 };
 
 use crate::batch::{LobeX8, Vec3x8};
 use crate::lanes::{ColumnKernel, Lanes, SliceVec, clamp, drive, max_num, min_num};
+
+/// `ln(2π)` of the `f32` `2π`, correctly rounded (the value `TAU.ln()` gives): a constant so
+/// that the crate needs no float functions of the standard library.
+const LN_TAU: f32 = f32::from_bits(0x3feb_3f8e);
+/// `ln(4π)` of the `f32` `4π`, correctly rounded.
+const LN_2TAU: f32 = f32::from_bits(0x4021_fc4d);
 
 /// Bound on the scale's difference from the scalar kernel, relative, per unit of `1 + L`
 /// (see the module docs). Measured: `5.9e-7`.
@@ -86,7 +92,7 @@ pub const MAX_WIDE_EXPONENT: f32 = 1.0e6;
 /// products `x·y` and `x²` of the baseline would be subnormal.
 const MIN_WIDE_SIN: f32 = 1.0e-18;
 
-/// `1/ln(1 + E/ε)` of `steradian_core::product::exponent_coord` (the same literal).
+/// `1/ln(1 + E/ε)` of `steradian_core::lobe::product::exponent_coord` (the same literal).
 const INV_LN_SPAN: f32 = 1.0 / 14.508_658;
 
 /// `ln x` for `x ≥ 0` including subnormals (wide's `ln` returns `−∞` for them): those are
@@ -258,8 +264,8 @@ fn ln_sg_integral<W: Lanes>(l1: W, l2: W, c: W, s: W) -> W {
     let ln_s = den
         .gt(zero)
         .select(W::splat(-4.0) * l1 * l2 * sh2 / den, zero);
-    let ln_int = W::splat(TAU.ln()) + ln_full(-(W::splat(-2.0) * lr).exp_m1()) - ln_full(lr);
-    ln_s + lr.eq(zero).select(W::splat((2.0 * TAU).ln()), ln_int)
+    let ln_int = W::splat(LN_TAU) + ln_full(-(W::splat(-2.0) * lr).exp_m1()) - ln_full(lr);
+    ln_s + lr.eq(zero).select(W::splat(LN_2TAU), ln_int)
 }
 
 /// The scalar `ProductTable::correction` at `(u1, u2, w)`: cell indices per lane, the eight
@@ -385,7 +391,7 @@ fn product_lanes<W: Lanes>(
         // falls back to the peak-matched exponent.
         (scale * p, e_r, redo_in | (e_r * zero).is_nan())
     } else {
-        let e_r = (W::splat(TAU.ln()) + base.ln_peak - ln_i).exp() - one;
+        let e_r = (W::splat(LN_TAU) + base.ln_peak - ln_i).exp() - one;
         (
             scale * exp_gradual(base.ln_peak),
             max_num(e_r, zero),
@@ -435,7 +441,7 @@ fn scalar_lanes<W: Lanes>(
 }
 
 /// The product of lobes `a` and `b` lane by lane, with `table` and `fit`: lane `k` is
-/// `steradian_core::product::product_with(table, fit, a_k, b_k)` for the lobes of
+/// `steradian_core::lobe::product::product_with(table, fit, a_k, b_k)` for the lobes of
 /// [`LobeX8::to_array`] — axis bit-identical, scale and exponent within the bounds of the
 /// module docs, non-finite or extreme lanes exactly (scalar kernel).
 #[inline]

@@ -14,7 +14,7 @@
 //!
 //! The product of `A = k_a + Σ a_i` and `B = k_b + Σ b_j` is expanded term by term:
 //! `k_a·k_b` (a constant), `k_a·b_j` and `a_i·k_b` (a lobe scaled exactly, eq. 41, no kernel
-//! call) and `a_i·b_j` (one call of [`crate::product::product`]). The product kernel is
+//! call) and `a_i·b_j` (one call of [`crate::lobe::product::product`]). The product kernel is
 //! called on *unit-scale* copies of the two lobes and the result is scaled by `s_a·s_b`
 //! here, so negative (visibility) and zero scales are exact.
 //!
@@ -68,9 +68,9 @@
 //! false with the threshold, so it is never pruned). A full [`LobeSum`] drops further lobes
 //! and counts them in [`ProductCounts::overflowed`]; [`LobeSum::try_push`] returns `false`.
 
-use crate::cap::{CapFit, SphericalCap};
+use crate::lobe::cap::{CapFit, SphericalCap};
+use crate::lobe::product;
 use crate::lobe::{self, CosineLobe, Lafortune, Phong};
-use crate::product;
 use crate::{TWO_PI, Vec3};
 
 /// `4π`: the integral of the constant 1 over the sphere.

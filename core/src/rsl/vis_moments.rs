@@ -1,7 +1,7 @@
 //! Visibility moment tables: the visible fraction **and the first moment of the visible
 //! part** of any square, from three exact summed-area tables of a binary visibility map.
 //! An extension of the rotatable-square-lights shading (section 3, eq. 5), not in the
-//! paper; [`crate::shade::shade_moments`] uses it.
+//! paper; [`crate::rsl::shade::shade_moments`] uses it.
 //!
 //! ## Why
 //!
@@ -9,7 +9,7 @@
 //! covariance of `ρ` and `V` over `R` (eq. 13's `u_L·σ_V·σ_ρ` term): large for the big,
 //! partly shadowed squares of a sky, where the cosine-weighted BRDF changes by a factor of
 //! two across the square. With `ρ` linear over the square, `φ(x) ≈ φ̄ + g·(x − c)` (a
-//! density per unit parametrisation area, [`crate::shade::BrdfIntegral::integral_gradient`]),
+//! density per unit parametrisation area, [`crate::rsl::shade::BrdfIntegral::integral_gradient`]),
 //!
 //! ```text
 //!   ∫_R φ·V dA ≈ φ̄·∫_R V dA + g·∫_R (x − c)·V dA = I·f + g·|R|·m,
@@ -17,14 +17,14 @@
 //! ```
 //!
 //! exact for a linear `φ` and any visibility. `f` and `m` are box sums of `V`, `u·V` and
-//! `v·V`: three summed-area tables ([`crate::sat`], exact `i64` fixed point). A query
+//! `v·V`: three summed-area tables ([`crate::rsl::sat`], exact `i64` fixed point). A query
 //! reads 32 distinct entries: `V` at the 4 × 4 knots of its box ([`axis_knots`]), the
 //! moment tables at 8 each.
 //!
 //! ## Grid, units, accuracy
 //!
 //! The map is `n × n` over the parametrisation square `[−1, 1]²` (texel `(i, j)` covers
-//! `[i, i+1]×[j, j+1]` in texel units, as [`crate::vdt`] and [`crate::visibility`]),
+//! `[i, i+1]×[j, j+1]` in texel units, as [`crate::rsl::vdt`] and [`crate::rsl::visibility`]),
 //! `V` = 1 where visible. The map is binary ([`VisMoments::build`]) or a coverage map
 //! ([`VisMoments::build_coverage`], `V` the visible fraction of each texel): a binary map
 //! moves every edge of the visible region by up to half a texel, which for the small
@@ -38,9 +38,9 @@
 //! piecewise-constant map up to `f64` rounding, for squares of any size (a square inside
 //! one texel included: a centre-moment table alone would put its moment up to half a
 //! texel away). Outside the table counts as visible (as
-//! [`crate::visibility::Outside::Visible`]: it is below the horizon, where the
+//! [`crate::rsl::visibility::Outside::Visible`]: it is below the horizon, where the
 //! cosine-weighted BRDF is 0). Queries take the centre and half-diagonal in disk units, as
-//! [`crate::shade::SquareVisibility`]; `m` is returned in disk units.
+//! [`crate::rsl::shade::SquareVisibility`]; `m` is returned in disk units.
 //!
 //! **Cost:** three tables of `(n + 1)²` `i64` entries, 1.6 MB at `n = 256` (the VDT: 256 KB).
 //!
@@ -51,8 +51,8 @@
 use alloc::vec::Vec;
 
 #[cfg(feature = "alloc")]
-use crate::sat::Sat;
-use crate::sat::SatView;
+use crate::rsl::sat::Sat;
+use crate::rsl::sat::SatView;
 use crate::{Error, Vec2};
 
 /// Three exact summed-area tables of a visibility map: `V`, `u·V`, `v·V` (module docs).
@@ -85,7 +85,7 @@ impl VisMoments {
     }
 
     /// The tables of an `n × n` coverage map, row-major (`coverage[j·n + i]`, the visible
-    /// fraction of each texel, as [`crate::visibility::coverage_into`] makes it): the
+    /// fraction of each texel, as [`crate::rsl::visibility::coverage_into`] makes it): the
     /// edges of the visible region are then resolved below a texel, which a binary map
     /// rounds to half a texel (module docs). Errors: `n` outside the SAT's range,
     /// `coverage.len() ≠ n²`, or a value that is not in `[0, 1]` (NaN included).
@@ -94,9 +94,9 @@ impl VisMoments {
             what: "visibility map side",
             value: n as f32,
             min: 1.0,
-            max: crate::sat::MAX_SIDE as f32,
+            max: crate::rsl::sat::MAX_SIDE as f32,
         })?;
-        crate::sat::check_len("visibility map length", coverage.len(), len)?;
+        crate::grid::check_len("visibility map length", coverage.len(), len)?;
         if let Some(&bad) = coverage.iter().find(|c| !(0.0..=1.0).contains(*c)) {
             return Err(Error::OutOfRange {
                 what: "visibility coverage",
@@ -200,7 +200,7 @@ impl<'a> VisMomentsView<'a> {
             return (f32::NAN, Vec2::NAN);
         }
         let hn = 0.5 * self.n as f64;
-        let h = f64::from(crate::sat::square_half_side(half_diagonal)) * hn;
+        let h = f64::from(crate::rsl::sat::square_half_side(half_diagonal)) * hn;
         if h <= 0.0 {
             return (1.0, Vec2::ZERO);
         }

@@ -56,16 +56,16 @@
 /// to zero on a GPU — for `m > 2¹²⁶`; the two differ by a common factor the normalisation
 /// removes. Tolerance: [`HEMISPHERE_MAP_ABS_TOL`].
 pub const HEMISPHERE_MAP: &str = concat!(
-    include_str!("wgsl/batch.wgsl"),
-    include_str!("wgsl/hemisphere_map.wgsl")
+    include_str!("batch.wgsl"),
+    include_str!("../rsl/hemisphere_map.wgsl")
 );
 /// Inverse hemisphere map, disk point → unit direction (`hemisphere::unmap`).
 /// Input columns `[u, v]`, output `[x, y, z]`. Points with `|p|² > 1` are clamped onto
 /// the unit circle; `|p|` must stay below `1.8e19` so that `|p|²` is finite.
 /// Tolerance: [`HEMISPHERE_UNMAP_ABS_TOL`].
 pub const HEMISPHERE_UNMAP: &str = concat!(
-    include_str!("wgsl/batch.wgsl"),
-    include_str!("wgsl/hemisphere_unmap.wgsl")
+    include_str!("batch.wgsl"),
+    include_str!("../rsl/hemisphere_unmap.wgsl")
 );
 /// Cosine lobe `s·max(a·v, 0)^e` as `s·exp(e·log1p(−|a − v|²/2))`, 0 where
 /// `|a − v|²/2 ≥ 1` (`lobe::eval`). Input columns `[ax, ay, az, s, e, vx, vy, vz]`, output
@@ -86,16 +86,16 @@ pub const HEMISPHERE_UNMAP: &str = concat!(
 /// kernel by more than the tolerance. Lavapipe does not fuse them.
 /// Tolerance: [`LOBE_EVAL_REL_TOL`].
 pub const LOBE_EVAL: &str = concat!(
-    include_str!("wgsl/batch.wgsl"),
-    include_str!("wgsl/log1p.wgsl"),
-    include_str!("wgsl/lobe_eval.wgsl")
+    include_str!("batch.wgsl"),
+    include_str!("log1p.wgsl"),
+    include_str!("../lobe/lobe_eval.wgsl")
 );
 /// Exact lobe integral `2π·s/(e + 1)` (`lobe::integral`). Input columns `[e, s]`, output
 /// `[integral]`; `|2π·s|` and `e + 1` must stay below `2¹²⁶`.
 /// Tolerance: [`LOBE_INTEGRAL_ULP_TOL`].
 pub const LOBE_INTEGRAL: &str = concat!(
-    include_str!("wgsl/batch.wgsl"),
-    include_str!("wgsl/lobe_integral.wgsl")
+    include_str!("batch.wgsl"),
+    include_str!("../lobe/lobe_integral.wgsl")
 );
 /// Cap → lobe L2 exponent looked up in the table of `h(α) = e*(α)·α²` (`cap::lookup`).
 /// Input column `[half_angle]`, output `[exponent]`; the table (`cap::TABLE`, or any table
@@ -103,8 +103,8 @@ pub const LOBE_INTEGRAL: &str = concat!(
 /// The constants `2/π` and the two-part `π/2` are the f32 values the scalar kernel uses.
 /// Tolerance: [`CAP_EXPONENT_REL_TOL`] and [`CAP_EXPONENT_ABS_TOL`].
 pub const CAP_EXPONENT: &str = concat!(
-    include_str!("wgsl/batch.wgsl"),
-    include_str!("wgsl/cap_exponent.wgsl")
+    include_str!("batch.wgsl"),
+    include_str!("../lobe/cap_exponent.wgsl")
 );
 
 /// Summed-area table box query (`sat::SatView::box_sum`). Input columns `[u0, v0, u1, v1]`,
@@ -117,9 +117,9 @@ pub const CAP_EXPONENT: &str = concat!(
 /// combined in `f32` (not `f64`), then scaled by `2^e` with two `ldexp` steps.
 /// Tolerance: [`SAT_BOX_REL_TOL`].
 pub const SAT_BOX: &str = concat!(
-    include_str!("wgsl/batch.wgsl"),
-    include_str!("wgsl/sat_lib.wgsl"),
-    include_str!("wgsl/sat.wgsl")
+    include_str!("batch.wgsl"),
+    include_str!("../rsl/sat_lib.wgsl"),
+    include_str!("../rsl/sat.wgsl")
 );
 /// Difference allowed between [`SAT_BOX`] and `sat::SatView::box_sum`, relative to
 /// `A = Σ|t|` over the texels the query reads (`sat` module docs): nine conversions and
@@ -137,9 +137,9 @@ pub const SAT_BOX_REL_TOL: f32 = 1.0e-6;
 /// operations as the scalar kernel (bilinear `(1 − t)·a + t·b`, in-cell gradient, eq. 9,
 /// straight-edge fraction). Tolerance: [`VDT_QUERY_TOL`].
 pub const VDT_QUERY: &str = concat!(
-    include_str!("wgsl/batch.wgsl"),
-    include_str!("wgsl/vdt_lib.wgsl"),
-    include_str!("wgsl/vdt.wgsl")
+    include_str!("batch.wgsl"),
+    include_str!("../rsl/vdt_lib.wgsl"),
+    include_str!("../rsl/vdt.wgsl")
 );
 /// Difference allowed between [`VDT_QUERY`] and `vdt::VdtView::query` per output, in units
 /// of `1 + |t|` with `t = D·√2/r` the distance in half-sides (WGSL division is 2.5 ulp and a
@@ -159,11 +159,11 @@ pub const VDT_QUERY_TOL: f32 = 2.0e-6;
 /// combination in `f32` (as [`SAT_BOX`]) and the map without the overflow-safe rescaling.
 /// Tolerance: [`SHADE_REL_TOL`].
 pub const SHADE: &str = concat!(
-    include_str!("wgsl/batch.wgsl"),
-    include_str!("wgsl/sat_lib.wgsl"),
-    include_str!("wgsl/vdt_lib.wgsl"),
-    include_str!("wgsl/shade_lib.wgsl"),
-    include_str!("wgsl/shade.wgsl")
+    include_str!("batch.wgsl"),
+    include_str!("../rsl/sat_lib.wgsl"),
+    include_str!("../rsl/vdt_lib.wgsl"),
+    include_str!("../rsl/shade_lib.wgsl"),
+    include_str!("../rsl/shade.wgsl")
 );
 /// Difference allowed between [`SHADE`] and `shade::shade`, per channel, relative to the
 /// point's largest channel (the `f32` SAT combination is within about `10⁻⁶` of the
@@ -200,10 +200,10 @@ pub const SHADE_REL_TOL: f32 = 1.0e-4;
 /// remainders below a quantum of `M` and `frac·V`. Sums are then combined in `f32`
 /// (not `f64`), the BRDF box sums as in [`SAT_BOX`]. Tolerance: [`SHADE_MOMENTS_REL_TOL`].
 pub const SHADE_MOMENTS: &str = concat!(
-    include_str!("wgsl/batch.wgsl"),
-    include_str!("wgsl/sat_lib.wgsl"),
-    include_str!("wgsl/shade_lib.wgsl"),
-    include_str!("wgsl/shade_moments.wgsl")
+    include_str!("batch.wgsl"),
+    include_str!("../rsl/sat_lib.wgsl"),
+    include_str!("../rsl/shade_lib.wgsl"),
+    include_str!("../rsl/shade_moments.wgsl")
 );
 /// Difference allowed between [`SHADE_MOMENTS`] and `shade::shade_moments`, per channel,
 /// relative to the point's largest channel. Lavapipe (harness test
@@ -232,16 +232,16 @@ pub const SHADE_MOMENTS_REL_TOL: f32 = 1.0e-5;
 /// about `1e-18` of opposite, where the baseline's intermediates overflow, are outside the
 /// finite-input contract. Tolerance: [`LOBE_PRODUCT_TOL`].
 pub const LOBE_PRODUCT: &str = concat!(
-    include_str!("wgsl/batch.wgsl"),
-    include_str!("wgsl/log1p.wgsl"),
-    include_str!("wgsl/product.wgsl")
+    include_str!("batch.wgsl"),
+    include_str!("log1p.wgsl"),
+    include_str!("../lobe/product.wgsl")
 );
 /// Difference allowed between [`LOBE_PRODUCT`] and `product::product_with`
 /// (`ExactIntegral`), per output: axis components absolutely; the scale relative per unit of
 /// `1 + L`, the exponent relative to `1 + e_r` per unit of `1 + L`, and the integral
 /// `2π·s/(e_r + 1)` relative per unit of `1 + L`, with `L = |ln p| + |ln I|` the size of
 /// the logarithms the outputs are exponentials of (`p` the peak value, `I` the integral of
-/// the product of the unit lobes; see `steradian_simd::product` for the same bound on the
+/// the product of the unit lobes; see `steradian_simd::lobe::product` for the same bound on the
 /// CPU). Results below `|s1·s2|·2⁻¹²⁶` may be flushed to 0. Lavapipe, over 10⁵ random
 /// pairs (harness test `tests/product_gpu.rs`, which prints them; its named hard cases are
 /// checked against the same tolerance): axis `1.2e-7`, scale `2.3e-7`, exponent `5.9e-7`,

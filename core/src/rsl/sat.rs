@@ -77,6 +77,7 @@
 //! the far edges too), without the float-to-index work. The table takes 8 bytes per entry,
 //! `(width + 1)·(height + 1)` entries.
 
+use crate::grid::{check_len, check_side, checked_product};
 use crate::math;
 use crate::{Error, Vec2};
 
@@ -597,45 +598,6 @@ fn check_shape(width: usize, height: usize, len: usize) -> Result<(), Error> {
 /// `(width + 1)·(height + 1)`, the number of table entries (sides already checked).
 fn entries(width: usize, height: usize) -> Result<usize, Error> {
     checked_product("table entries", width + 1, height + 1)
-}
-
-// The shape checks of the grid constructors (here, `vdt` and `visibility`).
-
-/// `Err` unless `1 ≤ n ≤ max`: a grid side.
-pub(crate) fn check_side(what: &'static str, n: usize, max: usize) -> Result<(), Error> {
-    if n == 0 || n > max {
-        return Err(Error::OutOfRange {
-            what,
-            value: n as f32,
-            min: 1.0,
-            max: max as f32,
-        });
-    }
-    Ok(())
-}
-
-/// `Err` unless a slice length `got` is exactly `want`.
-pub(crate) fn check_len(what: &'static str, got: usize, want: usize) -> Result<(), Error> {
-    if got != want {
-        return Err(Error::OutOfRange {
-            what,
-            value: got as f32,
-            min: want as f32,
-            max: want as f32,
-        });
-    }
-    Ok(())
-}
-
-/// `a·b`, or `Err` where it overflows `usize` (sides of up to `2²⁴` can only overflow a
-/// `usize` narrower than 64 bits).
-pub(crate) fn checked_product(what: &'static str, a: usize, b: usize) -> Result<usize, Error> {
-    a.checked_mul(b).ok_or(Error::OutOfRange {
-        what,
-        value: f32::INFINITY,
-        min: 1.0,
-        max: usize::MAX as f32,
-    })
 }
 
 #[cfg(feature = "alloc")]

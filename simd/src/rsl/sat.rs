@@ -1,6 +1,6 @@
-//! Summed-area table box queries, 8 lanes at a time (mirrors `steradian_core::sat`).
+//! Summed-area table box queries, 8 lanes at a time (mirrors `steradian_core::rsl::sat`).
 //!
-//! [`box_sum`] performs the operations of `steradian_core::sat::SatView::box_sum` lane-wise:
+//! [`box_sum`] performs the operations of `steradian_core::rsl::sat::SatView::box_sum` lane-wise:
 //! the ordering and clipping of the corners with comparisons and selects, `floor`, the
 //! exact fractions, the sixteen table reads (scalar loads: `wide` has no gather), the 27
 //! exact `i64` subtractions in `i64x8`, the nine `i64 → f64` conversions, the `f64`
@@ -8,12 +8,12 @@
 //! quantum and the one rounding to `f32`. So every lane is **bit-identical** to the scalar
 //! kernel, NaN lanes included (NaN exactly where a corner is NaN).
 
-use steradian_core::sat::{SatView, square_half_side};
+use steradian_core::rsl::sat::{SatView, square_half_side};
 use wide::{f32x8, f64x8, i64x8};
 
 use crate::lanes::{ColumnKernel, Lanes, drive};
 
-/// One axis of 8 boxes, lane-wise `steradian_core::sat::axis`: `(I0, a0, I1, a1)`, the
+/// One axis of 8 boxes, lane-wise `steradian_core::rsl::sat::axis`: `(I0, a0, I1, a1)`, the
 /// indices as exact integers in `f32` lanes. Lanes must not be NaN.
 #[inline(always)]
 fn axis(c0: f32x8, c1: f32x8, n: usize) -> (f32x8, f32x8, f32x8, f32x8) {

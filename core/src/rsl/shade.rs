@@ -17,15 +17,15 @@
 //! ```
 //!
 //! This is Figure 8's `T = I·Vs·Vq/s` with `I·s = Eᵢ` (the paper's `2r²I`), `Vq/s = ρ̄ᵢ` and
-//! `Vs/s = V̄ᵢ`. The cosine is folded into `ρ` ([`crate::brdf`]), so the part of a square
+//! `Vs/s = V̄ᵢ`. The cosine is folded into `ρ` ([`crate::lobe::brdf`]), so the part of a square
 //! below the horizon (outside the unit disk, where the table is 0) contributes nothing, while
 //! `Ωᵢ` is the whole square: a light half below the horizon gives half its energy at most.
 //! A square wholly below the horizon ([`crate::rsl::ProjectedSquare::is_below_horizon`]) is
 //! skipped. The paper multiplies one visibility factor per occluder (its OVDF) and one for
 //! self-visibility (SVDF); here one table holds the union of every occluder's cap seen from
-//! the point ([`crate::visibility`]), so `V̄ᵢ` is a single lookup per light.
+//! the point ([`crate::rsl::visibility`]), so `V̄ᵢ` is a single lookup per light.
 //!
-//! **Colour.** The BRDF is grey (a scalar, as [`crate::brdf::Brdf`]); the lights are RGB.
+//! **Colour.** The BRDF is grey (a scalar, as [`crate::lobe::brdf::Brdf`]); the lights are RGB.
 //! The kernel computes the scalar `fᵢ = ρ̄ᵢ·V̄ᵢ` once per light and accumulates `Eᵢ·fᵢ` in
 //! three channels (RGB out at the cost of three multiply-adds per light). Luminance is
 //! [`crate::rsl::luminance`] of the result.
@@ -39,8 +39,8 @@
 //! `B` is exact when `L`, `ρ` and `V` are constant over every region and every square
 //! matches its region; otherwise the error is the sum of (a) the multi-product error of
 //! eq. 5, bounded by eq. 13 ([`multi_product_bound`]), (b) the square-for-region mismatch
-//! of eq. 6 (section 6.2), (c) the BRDF SAT's error ([`crate::brdf_sat`]) and (d) the VDT's
-//! error ([`crate::vdt`]). The harness (`harness/src/shade.rs`) measures each against the
+//! of eq. 6 (section 6.2), (c) the BRDF SAT's error ([`crate::rsl::brdf_sat`]) and (d) the VDT's
+//! error ([`crate::rsl::vdt`]). The harness (`harness/src/shade.rs`) measures each against the
 //! `f64` integral of `L·ρ·V` over every environment texel with exact ray-sphere visibility,
 //! by replacing the factors one at a time by their exact values. `harness/tests/shade.rs`
 //! asserts that the kernel's relative L2 error falls with `K` and reports it (Lambert,
@@ -60,9 +60,9 @@
 //! - the BRDF density is a plane, `φ ≈ I/|R| + g·d` (the BRDF SAT's integral `I` and plane
 //!   fit `g`, [`BrdfIntegral::integral_gradient`], three box queries per table);
 //! - the light is linear, `L ≈ E/Ω + a·d` with `a = (∂ω/∂p)ᵀ·F⁻¹G` from the RSL's radiance
-//!   gradient `G` ([`crate::rsl::Rsl::gradient`], [`crate::hemisphere::unmap_jacobian`]);
+//!   gradient `G` ([`crate::rsl::Rsl::gradient`], [`crate::rsl::hemisphere::unmap_jacobian`]);
 //! - the visibility enters by its fraction `f` and first moment `m` over the square, from
-//!   three exact summed-area tables of the point's coverage map ([`crate::vis_moments`]);
+//!   three exact summed-area tables of the point's coverage map ([`crate::rsl::vis_moments`]);
 //!   its second moment is taken as the whole square's, `f·h²/3` per axis.
 //!
 //! ```text
@@ -78,7 +78,7 @@
 //! lights over the same squares, and 0.51 % / 0.29 % for the paper's uniform squares.
 //! Cost: 0.21–0.42× the eq. 5 kernel's scalar speed (report runs on the dev machine),
 //! and three `(n + 1)²` `i64` tables per point instead of one `n²` `f32` VDT. The SIMD
-//! twin (`steradian_simd::shade::shade_moments_batch`, tested lane by lane) runs at about
+//! twin (`steradian_simd::rsl::shade::shade_moments_batch`, tested lane by lane) runs at about
 //! 4.7× this scalar kernel; the WGSL twin is [`crate::wgsl::SHADE_MOMENTS`].
 //!
 //! ## Eq. 13 (section 6.1)
@@ -106,20 +106,20 @@
 
 use crate::frame::Frame;
 use crate::math;
+use crate::rsl::vdt::VdtView;
 use crate::rsl::{ProjectedSquare, Rsl, map_extended};
-use crate::vdt::VdtView;
 use crate::{Error, Vec2, Vec3};
 
 /// The BRDF factor of eq. 5: `∫_R ρ(wᵢ, wₒ)·cos θᵢ dωᵢ` over the square of the
 /// parametrisation plane with centre `centre` and half-diagonal `half_diagonal` (disk units,
-/// [`crate::hemisphere`]), for the local view `wo_local`. Implemented by the BRDF summed-area
-/// tables (`crate::brdf_sat::BrdfSat`); the harness's factor analysis integrates the BRDF
+/// [`crate::rsl::hemisphere`]), for the local view `wo_local`. Implemented by the BRDF summed-area
+/// tables (`crate::rsl::brdf_sat::BrdfSat`); the harness's factor analysis integrates the BRDF
 /// exactly beside it to measure the tables' share of the shading error.
 pub trait BrdfIntegral {
     /// The integral (not the mean: the kernel divides by the light's solid angle).
     fn integral(&self, wo_local: Vec3, centre: Vec2, half_diagonal: f32) -> f32;
     /// The integral and the gradient of its density per unit parametrisation area over the
-    /// square (a plane fit, [`crate::brdf_sat::BrdfSat::integral_gradient`]), for
+    /// square (a plane fit, [`crate::rsl::brdf_sat::BrdfSat::integral_gradient`]), for
     /// [`shade_moments`]. The default is a flat density (zero gradient).
     fn integral_gradient(&self, wo_local: Vec3, centre: Vec2, half_diagonal: f32) -> (f32, Vec2) {
         (self.integral(wo_local, centre, half_diagonal), Vec2::ZERO)
@@ -127,36 +127,36 @@ pub trait BrdfIntegral {
 }
 
 #[cfg(feature = "alloc")]
-impl BrdfIntegral for crate::brdf_sat::BrdfSat {
+impl BrdfIntegral for crate::rsl::brdf_sat::BrdfSat {
     #[inline]
     fn integral(&self, wo_local: Vec3, centre: Vec2, half_diagonal: f32) -> f32 {
-        crate::brdf_sat::BrdfSat::integral(self, wo_local, centre, half_diagonal)
+        crate::rsl::brdf_sat::BrdfSat::integral(self, wo_local, centre, half_diagonal)
     }
     #[inline]
     fn integral_gradient(&self, wo_local: Vec3, centre: Vec2, half_diagonal: f32) -> (f32, Vec2) {
-        crate::brdf_sat::BrdfSat::integral_gradient(self, wo_local, centre, half_diagonal)
+        crate::rsl::brdf_sat::BrdfSat::integral_gradient(self, wo_local, centre, half_diagonal)
     }
 }
 
 /// The visibility of a square as its visible fraction `f` and the mean of `(x − c)·V`
-/// over it, `m` (disk units): [`crate::vis_moments::VisMoments`].
+/// over it, `m` (disk units): [`crate::rsl::vis_moments::VisMoments`].
 pub trait SquareMoments {
     /// `(f, m)`.
     fn moments(&self, centre: Vec2, half_diagonal: f32) -> (f32, Vec2);
 }
 
-impl SquareMoments for crate::vis_moments::VisMomentsView<'_> {
+impl SquareMoments for crate::rsl::vis_moments::VisMomentsView<'_> {
     #[inline]
     fn moments(&self, centre: Vec2, half_diagonal: f32) -> (f32, Vec2) {
-        crate::vis_moments::VisMomentsView::moments(self, centre, half_diagonal)
+        crate::rsl::vis_moments::VisMomentsView::moments(self, centre, half_diagonal)
     }
 }
 
 #[cfg(feature = "alloc")]
-impl SquareMoments for crate::vis_moments::VisMoments {
+impl SquareMoments for crate::rsl::vis_moments::VisMoments {
     #[inline]
     fn moments(&self, centre: Vec2, half_diagonal: f32) -> (f32, Vec2) {
-        crate::vis_moments::VisMoments::moments(self, centre, half_diagonal)
+        crate::rsl::vis_moments::VisMoments::moments(self, centre, half_diagonal)
     }
 }
 
@@ -178,7 +178,7 @@ impl SquareVisibility for Unoccluded {
     }
 }
 
-/// Which VDT estimate of the visible fraction to use ([`crate::vdt`]).
+/// Which VDT estimate of the visible fraction to use ([`crate::rsl::vdt`]).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum VdtQuery {
     /// The paper's eq. 9 ramp.
@@ -407,7 +407,7 @@ where
         // ∫(x − c)·φ·V over the square, the visible part's second moment taken as the
         // whole square's (h²/3 per axis) times f, then carried to world directions.
         let w = i * m + (area * f * r * r * (1.0 / 6.0)) * g;
-        let (ju, jv) = crate::hemisphere::unmap_jacobian(p);
+        let (ju, jv) = crate::rsl::hemisphere::unmap_jacobian(p);
         let u = frame.to_world(ju * w.x + jv * w.y);
         for (o, gc) in out.iter_mut().zip(&light.gradient) {
             *o = clamp_keep_nan(*o + gc.dot(u), f32::INFINITY);
@@ -634,7 +634,7 @@ mod tests {
         let centre = l.centre();
         for ch in 0..3 {
             let gw = l.gradient()[ch];
-            let at = |p: Vec2| gw.dot(f.to_world(crate::hemisphere::unmap(p)) - centre);
+            let at = |p: Vec2| gw.dot(f.to_world(crate::rsl::hemisphere::unmap(p)) - centre);
             let e = 1e-3;
             let ax = (at(c + Vec2::new(e, 0.0)) - at(c - Vec2::new(e, 0.0))) / (2.0 * e);
             let ay = (at(c + Vec2::new(0.0, e)) - at(c - Vec2::new(0.0, e))) / (2.0 * e);

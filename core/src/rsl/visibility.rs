@@ -1,7 +1,7 @@
 //! Visibility maps from sphere occluders (rotatable-square-lights paper, sections 4.3 and 5):
 //! the directions of the upper hemisphere of a shading point that are blocked by a set of
 //! spheres, rasterised onto an `n × n` grid over the parametrisation square of the
-//! equal-area map ([`crate::hemisphere`]) with **coverage**: texel `(i, j)` holds the
+//! equal-area map ([`crate::rsl::hemisphere`]) with **coverage**: texel `(i, j)` holds the
 //! fraction of its area that is visible.
 //!
 //! A sphere seen from the point is a [`SphericalCap`] of directions (`sin α = radius /
@@ -25,7 +25,7 @@
 //! or nothing; a crossed one is split in four, down to [`LEAF_DEPTH`] levels (leaves of
 //! `1/32` texel side). At a leaf crossed by one boundary the boundary is replaced by its
 //! tangent line (from the value and a central-difference gradient) and the leaf's fraction on
-//! the visible side is the exact straight-edge area ([`crate::vdt::square_halfplane_fraction`]);
+//! the visible side is the exact straight-edge area ([`crate::rsl::vdt::square_halfplane_fraction`]);
 //! a leaf crossed by two or more boundaries (where caps overlap or meet the horizon) is
 //! point-sampled 4 × 4. The error per texel is of the order of the boundary's curvature times
 //! the cube of the leaf size; the harness tests the total visible solid angle of one sphere
@@ -43,12 +43,12 @@
 //! **Bad input** (never panics): [`coverage_into`] rejects `n = 0`, `n > 2²⁴` and an output
 //! of the wrong length; the caps are already validated [`SphericalCap`]s.
 
-use crate::cap::SphericalCap;
 use crate::frame::Frame;
-use crate::hemisphere;
+use crate::grid::square_halfplane_fraction;
+use crate::grid::{check_len, check_side, checked_product};
+use crate::lobe::cap::SphericalCap;
 use crate::math;
-use crate::sat::{check_len, check_side, checked_product};
-use crate::vdt::square_halfplane_fraction;
+use crate::rsl::hemisphere;
 use crate::{Error, Vec2, Vec3};
 
 /// Subdivision levels below a texel (leaves of `2⁻⁵` texel side).

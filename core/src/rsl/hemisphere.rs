@@ -83,7 +83,7 @@ pub fn unmap(p: Vec2) -> Vec3 {
 /// (the antipode), where `s → 0`; `|p|²` is clamped to `2 − 2⁻¹²` there so the result
 /// stays finite (near the antipode a first-order model of the map is meaningless anyway).
 /// Used by the moments kernel to carry a light's radiance gradient into the parametrisation
-/// ([`crate::shade::light_moments`]). NaN in gives NaN.
+/// ([`crate::rsl::shade::light_moments`]). NaN in gives NaN.
 #[inline]
 pub fn unmap_jacobian(p: Vec2) -> (Vec3, Vec3) {
     let r2 = (p.x * p.x + p.y * p.y).min(2.0 - 1.0 / 4096.0);

@@ -1,4 +1,4 @@
-//! RSL shading, 8 shading points at a time (mirrors `steradian_core::shade::shade` with an
+//! RSL shading, 8 shading points at a time (mirrors `steradian_core::rsl::shade::shade` with an
 //! isotropic BRDF SAT and a VDT per point).
 //!
 //! Each lane is one shading point; the loop runs over the lights. Per light and lane: the
@@ -8,7 +8,7 @@
 //! between which a point's view is interpolated are read at the **same** indices (the square
 //! is the same), so the corner arithmetic is done once for both (the scalar kernel repeats
 //! it per table). Exact integer arithmetic of the SAT (`i64x8`) and the `f64x8` combination
-//! follow `steradian_core::sat` operation for operation.
+//! follow `steradian_core::rsl::sat` operation for operation.
 //!
 //! **Accuracy against the scalar kernel.** Not bit-identical: the map is computed without
 //! the scalar kernel's overflow-safe rescaling (the light centres and frames are unit, so
@@ -25,10 +25,10 @@
 
 use glam::Vec3;
 use steradian_core::frame::Frame;
-use steradian_core::sat::SatView;
-use steradian_core::shade::{ShadeLight, VdtQuery};
-use steradian_core::vdt::{Q_MIN, R_MAX, R_MIN, VdtView};
-use steradian_core::vis_moments::{AxisKnots, VisMomentsView, axis_knots};
+use steradian_core::rsl::sat::SatView;
+use steradian_core::rsl::shade::{ShadeLight, VdtQuery};
+use steradian_core::rsl::vdt::{Q_MIN, R_MAX, R_MIN, VdtView};
+use steradian_core::rsl::vis_moments::{AxisKnots, VisMomentsView, axis_knots};
 use wide::{f32x8, f64x8, i64x8};
 
 /// Relative difference allowed between [`shade_batch`] and the scalar kernel, per channel,
@@ -74,8 +74,8 @@ struct ViewLane {
 
 fn view_lane(tables: &IsoBrdfTables<'_>, wo: Vec3) -> ViewLane {
     let m = tables.tables.len();
-    let p = steradian_core::hemisphere::map(wo);
-    let s = (p.x * p.x + p.y * p.y).sqrt();
+    let p = steradian_core::rsl::hemisphere::map(wo);
+    let s = steradian_core::math::sqrtf(p.x * p.x + p.y * p.y);
     let x = (s / tables.s_max * (m - 1) as f32).clamp(0.0, (m - 1) as f32);
     let k0 = (x as usize).min(m - 2);
     let (c, sn) = if s > 0.0 {
@@ -97,7 +97,7 @@ fn sel(m: f32x8, t: f32x8, f: f32x8) -> f32x8 {
     m.select(t, f)
 }
 
-/// `steradian_core::sat::axis` lane-wise: `(I0, a0, I1, a1)` for `lo ≤ hi` (no NaN).
+/// `steradian_core::rsl::sat::axis` lane-wise: `(I0, a0, I1, a1)` for `lo ≤ hi` (no NaN).
 #[inline(always)]
 fn sat_axis(lo: f32x8, hi: f32x8, n: usize) -> (f32x8, f32x8, f32x8, f32x8) {
     let nf = f32x8::splat(n as f32);
@@ -193,7 +193,7 @@ fn box_pair_f64(
     (one(&g[0], quanta[0]), one(&g[1], quanta[1]))
 }
 
-/// The straight-edge fraction (`steradian_core::vdt::square_halfplane_fraction` after the
+/// The straight-edge fraction (`steradian_core::rsl::vdt::square_halfplane_fraction` after the
 /// reduction of the normal to `q`), lane-wise.
 #[inline(always)]
 fn edge_fraction(t: f32x8, q: f32x8) -> f32x8 {
@@ -517,7 +517,7 @@ fn vis_moments_lanes(
     r: f32,
 ) -> (f32x8, [f32x8; 2]) {
     let hn = 0.5 * n as f64;
-    let h = f64::from(steradian_core::sat::square_half_side(r)) * hn;
+    let h = f64::from(steradian_core::rsl::sat::square_half_side(r)) * hn;
     if h <= 0.0 {
         return (f32x8::ONE, [f32x8::ZERO; 2]);
     }
@@ -611,7 +611,7 @@ fn vis_moments_lanes(
     )
 }
 
-/// The moments kernel (`steradian_core::shade::shade_moments` with an isotropic BRDF SAT and
+/// The moments kernel (`steradian_core::rsl::shade::shade_moments` with an isotropic BRDF SAT and
 /// visibility moment tables per point) for 8 points, RGB per lane. All moment tables must
 /// have the same side and the BRDF tables the same size; otherwise (or with fewer than 2
 /// BRDF tables) returns `None`.
@@ -637,7 +637,7 @@ pub fn shade_moments_x8(
             continue;
         }
         let centre = lanes.brdf_centre(px, py, f32x8::splat(half_b));
-        let h = steradian_core::sat::square_half_side(r) * half_b;
+        let h = steradian_core::rsl::sat::square_half_side(r) * half_b;
         let (i, g) = brdf_gradient(&lanes, tabs, centre, h, half_b, bw, bh);
         let (f, m) = vis_moments_lanes(&vis, n, px, py, r);
         // `shade::light_moments`, lane-wise.

@@ -20,7 +20,7 @@
 //! - [`Rsl::gradient`] (an extension, zero by default): a radiance gradient per channel,
 //!   a world-space vector orthogonal to `c`, for the linear light model
 //!   `L(ω) = energy/Ω + G·(ω − c)` over the square that the moments kernel
-//!   ([`crate::shade::light_moments`]) evaluates. The paper's lights are uniform
+//!   ([`crate::rsl::shade::light_moments`]) evaluates. The paper's lights are uniform
 //!   (`G = 0`); the harness's decomposition sets `G` by matching the square's first moment
 //!   of radiance to the region's (`harness/src/env/decompose.rs`, "Radiance gradient").
 //!
@@ -28,7 +28,7 @@
 //!
 //! At a shading point with frame `F` the centre becomes `c' = F⁻¹·c` and the region is
 //! approximated by a square in the equal-area parametrisation of
-//! [`crate::hemisphere`] with centre `p = map(c')` and half-diagonal `r`:
+//! [`crate::rsl::hemisphere`] with centre `p = map(c')` and half-diagonal `r`:
 //!
 //! ```text
 //!   p = (c'x, c'y)/sqrt(1 + c'z)          (|p|² = 1 − c'z)
@@ -46,7 +46,7 @@
 //!
 //! ## Accuracy
 //!
-//! - The centre is within [`crate::hemisphere::MAP_ABS_ERROR`] of the exact map, and
+//! - The centre is within [`crate::rsl::hemisphere::MAP_ABS_ERROR`] of the exact map, and
 //!   `2·area(R) = Ω` up to one f32 rounding (by construction).
 //! - The *shape* is the paper's approximation (section 6.2): to first order in the light's
 //!   size the map at polar angle `γ` of `c'` scales radial lengths by `k/√2` and tangential
@@ -74,6 +74,15 @@
 //!
 //! [`Rsl::new`] validates and returns [`Error`]. The projections never panic: NaN in any
 //! component gives NaN out; a zero local direction maps to the pole.
+
+#[cfg(feature = "alloc")]
+pub mod brdf_sat;
+pub mod hemisphere;
+pub mod sat;
+pub mod shade;
+pub mod vdt;
+pub mod vis_moments;
+pub mod visibility;
 
 use crate::frame::{Frame, check_dir, normalize_or_zero};
 use crate::math;
@@ -238,16 +247,16 @@ pub fn half_diagonal(omega: f32) -> f32 {
     0.5 * math::sqrtf(omega)
 }
 
-/// The equal-area map of [`crate::hemisphere::map`] extended to the whole sphere (Lambert
+/// The equal-area map of [`crate::rsl::hemisphere::map`] extended to the whole sphere (Lambert
 /// azimuthal equal-area, scaled by `1/√2`): `p = (x, y)/sqrt(1 + z)` of the normalised
 /// input, `|p| = sqrt(1 − z) ∈ [0, √2]`, `dω = 2·du·dv` everywhere. For `z ≥ 0` it equals
-/// [`crate::hemisphere::map`]. The antipode `−z`, whose image is the whole circle of radius
+/// [`crate::rsl::hemisphere::map`]. The antipode `−z`, whose image is the whole circle of radius
 /// `√2`, maps to `(√2, 0)`. NaN in gives NaN; the zero vector gives the pole.
 #[inline]
 pub fn map_extended(dir: Vec3) -> Vec2 {
     let d = normalize_or_zero(dir);
     if d.z >= 0.0 || d.z.is_nan() || d == Vec3::ZERO {
-        return crate::hemisphere::map(dir);
+        return crate::rsl::hemisphere::map(dir);
     }
     let s2 = d.x * d.x + d.y * d.y;
     let rho = math::sqrtf(1.0 - d.z);
@@ -426,7 +435,7 @@ mod tests {
             Vec3::X,
             Vec3::new(0.0, 1.0, 1e-7),
         ] {
-            assert_eq!(map_extended(d), crate::hemisphere::map(d));
+            assert_eq!(map_extended(d), crate::rsl::hemisphere::map(d));
         }
         // across the horizon: continuous, radius sqrt(1 − z)
         let a = map_extended(Vec3::new(0.6, 0.8, 1e-6));

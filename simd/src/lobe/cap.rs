@@ -1,6 +1,6 @@
-//! Cap → lobe exponent lookup, 8 lanes at a time (mirrors `steradian_core::cap`).
+//! Cap → lobe exponent lookup, 8 lanes at a time (mirrors `steradian_core::lobe::cap`).
 //!
-//! [`lookup`] performs exactly the operations of `steradian_core::cap::lookup` lane-wise
+//! [`lookup`] performs exactly the operations of `steradian_core::lobe::cap::lookup` lane-wise
 //! (the NaN-keeping clamp of `α`, `u = π/2 − α` with a two-part π/2,
 //! `r = (N − 1)·sqrt(2u/π)` with their NaN-ignoring `max` and `min`, the interval
 //! `k = max(⌈r⌉, 1)`, the fraction `(k − r)(k + r)/(2k − 1)`, linear interpolation, division
@@ -10,15 +10,15 @@
 
 use core::f32::consts::{FRAC_PI_2, PI};
 
-use steradian_core::cap::{MIN_HALF_ANGLE, TABLE};
+use steradian_core::lobe::cap::{MIN_HALF_ANGLE, TABLE};
 use wide::f32x8;
 
 use crate::batch::PAD_F32;
 use crate::lanes::{ColumnKernel, Lanes, SliceVec, clamp, drive, max_num, min_num};
 
 /// `π/2 − FRAC_PI_2` (the `f32` constant rounds π/2 up by this much); the same literal as
-/// `steradian_core::cap`'s private constant.
-use steradian_core::cap::FRAC_PI_2_LO;
+/// `steradian_core::lobe::cap`'s private constant.
+use steradian_core::lobe::cap::FRAC_PI_2_LO;
 
 /// Tables up to this length are looked up lane-wise: every grid coordinate and index is
 /// then an exact `f32` integer (`≤ 2²⁴`). Longer tables go through the scalar kernel lane by
@@ -26,7 +26,7 @@ use steradian_core::cap::FRAC_PI_2_LO;
 const MAX_WIDE_TABLE: usize = 1 << 24;
 
 /// The L2-optimal exponent of a unit-scale lobe for caps of half-angles `half_angle`, from the
-/// built-in table: lane-wise `steradian_core::cap::exponent_l2`, bit-identical.
+/// built-in table: lane-wise `steradian_core::lobe::cap::exponent_l2`, bit-identical.
 ///
 /// Saturating: `α` is clamped to `[MIN_HALF_ANGLE, π/2]`; NaN gives NaN.
 #[inline]
@@ -35,7 +35,7 @@ pub fn exponent_l2(half_angle: f32x8) -> f32x8 {
 }
 
 /// [`exponent_l2`] with a caller-supplied table of `h(α) = e*·α²` samples on the grid of
-/// `steradian_core::cap::lookup`: lane-wise `steradian_core::cap::lookup`, bit-identical. A
+/// `steradian_core::lobe::cap::lookup`: lane-wise `steradian_core::lobe::cap::lookup`, bit-identical. A
 /// table with fewer than two samples gives NaN.
 #[inline]
 pub fn lookup(table: &[f32], half_angle: f32x8) -> f32x8 {
@@ -51,7 +51,7 @@ fn lookup_lanes<W: Lanes>(table: &[f32], half_angle: W) -> W {
     }
     if n > MAX_WIDE_TABLE {
         let a = half_angle.lanes();
-        return W::from_fn(|k| steradian_core::cap::lookup(table, a[k]));
+        return W::from_fn(|k| steradian_core::lobe::cap::lookup(table, a[k]));
     }
     let one = W::splat(1.0);
     let last = W::splat((n - 1) as f32);

@@ -31,6 +31,23 @@ use wide::f32x8;
 use crate::batch::{LobeX8, PAD_F32, PAD_VEC3, Vec3x8};
 use crate::lanes::{ColumnKernel, Lanes, SliceVec, drive};
 
+pub mod cap;
+pub mod product;
+
+impl LobeX8 {
+    /// [`eval`] of this batch.
+    #[inline]
+    pub fn eval(self, v: Vec3x8) -> f32x8 {
+        eval(self, v)
+    }
+
+    /// [`integral`] of this batch.
+    #[inline]
+    pub fn integral(self) -> f32x8 {
+        integral(self.exponent, self.scale)
+    }
+}
+
 /// Relative tolerance of [`eval`] against `steradian_core::lobe::eval`, per unit of
 /// `1 + |ln(c/s)|` (see the module docs). Measured maximum: `3.1e-7` over 2·10⁷
 /// pseudo-random lanes (`eval_survey` in `tests/contract.rs`).

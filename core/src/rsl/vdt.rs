@@ -10,7 +10,7 @@
 //! ## Grid and boundary (the definitions every function here uses)
 //!
 //! Texel `(i, j)` of a `w × h` map covers `[i, i+1]×[j, j+1]` in texel units (`i` along
-//! `u`, `j` along `v`, row-major storage `j·w + i`), as in [`crate::sat`]. The map is the
+//! `u`, `j` along `v`, row-major storage `j·w + i`), as in [`crate::rsl::sat`]. The map is the
 //! piecewise-constant function of its texels, and its **boundary** `B` is the union of the
 //! texel edges that separate a visible texel from an occluded one (the border of the grid is
 //! not a boundary: nothing is known beyond it). `D` is sampled at texel centres:
@@ -69,8 +69,9 @@
 //! clamp to the edge of the table, and NaN in `u`, `v` or `r` gives NaN.
 
 use crate::Error;
+pub use crate::grid::{Q_MIN, square_halfplane_fraction};
+use crate::grid::{check_len, check_side, checked_product};
 use crate::math;
-use crate::sat::{check_len, check_side, checked_product};
 use core::f32::consts::SQRT_2;
 
 /// Largest width or height of a table: every texel coordinate is an exact `f32`, and every
@@ -89,11 +90,6 @@ pub const NO_BOUNDARY: f32 = 1.267_650_6e30;
 pub const R_MIN: f32 = 1.0e-12;
 /// Largest half-diagonal of a query (texel units), `2⁸⁰`; larger ones are clamped to it.
 pub const R_MAX: f32 = 1.208_925_8e24;
-
-/// Below this, the smaller normal component `q` of the straight-edge fraction is treated as
-/// this in the divisions of the two corner pieces (whose numerators are then at most `4q²`,
-/// so the result is the exact limit `q → 0` to within `q/2`).
-pub const Q_MIN: f32 = 1.0e-20;
 
 /// Length of the `f64` scratch buffer [`signed_distance_into`] needs for a `w × h` map:
 /// `(w + 1)·(h + 5)`.
@@ -332,48 +328,6 @@ pub fn signed_distance_into(
     Ok(())
 }
 
-/// The exact fraction of the square `[−1, 1]²` on the side `x·nx + y·ny ≥ −t` of a straight
-/// line, for a normal `(nx, ny)` (any length, not both zero: it is normalised here; a zero
-/// normal falls back to `(1, 0)`) and `t` the signed distance of the line from the centre in
-/// units of the half-side (`t > 0`: the centre is on the visible side).
-///
-/// With `q = min(|nx|, |ny|)/max(|nx|, |ny|)` and `T = t·√(1 + q²)` clamped to `±(1 + q)`
-/// (`X = x + q·y` has a trapezoidal density on `[−1−q, 1+q]`):
-///
-/// ```text
-/// T ≤ q − 1:  (T + 1 + q)²/(8q)
-/// T ≥ 1 − q:  1 − (1 + q − T)²/(8q)
-/// otherwise:  (T + 1)/2
-/// ```
-///
-/// the divisions by `max(q, `[`Q_MIN`]`)`. Within a few `f32` ulps of the exact fraction
-/// (harness test against `f64` polygon clipping). NaN `t` gives NaN; `±∞` gives 1 or 0.
-#[inline(always)]
-pub fn square_halfplane_fraction(t: f32, nx: f32, ny: f32) -> f32 {
-    let (ax, ay) = (nx.abs(), ny.abs());
-    let m = ax.max(ay);
-    let q = if m > 0.0 { ax.min(ay) / m } else { 0.0 };
-    edge_fraction(t, q)
-}
-
-/// [`square_halfplane_fraction`] after the normal has been reduced to `q ∈ [0, 1]`.
-#[inline(always)]
-fn edge_fraction(t: f32, q: f32) -> f32 {
-    let len = math::sqrtf(1.0 + q * q);
-    let hi = 1.0 + q;
-    let tt = (t * len).clamp(-hi, hi);
-    let den = 8.0 * q.max(Q_MIN);
-    // All three pieces, then a choice (compiled to selects, not branches: random queries
-    // fall on all three).
-    let lo_e = tt + hi;
-    let lo_v = lo_e * lo_e / den;
-    let hi_e = hi - tt;
-    let hi_v = 1.0 - hi_e * hi_e / den;
-    let mid = (tt + 1.0) * 0.5;
-    let r = if tt >= 1.0 - q { hi_v } else { mid };
-    if tt <= q - 1.0 { lo_v } else { r }
-}
-
 /// `(1 − t)·a + t·b`: exact at `t = 0` and `t = 1`.
 #[inline(always)]
 fn lerp(a: f32, b: f32, t: f32) -> f32 {
@@ -574,13 +528,13 @@ mod owned {
         }
 
         /// The VDT of a coverage map (visible fraction per texel, finite): a texel is
-        /// visible when its coverage is at least ½ ([`crate::visibility::binary_into`]).
+        /// visible when its coverage is at least ½ ([`crate::rsl::visibility::binary_into`]).
         pub fn from_coverage(w: usize, h: usize, coverage: &[f32]) -> Result<Vdt, Error> {
             if coverage.iter().any(|c| !c.is_finite()) {
                 return Err(Error::NonFinite { what: "coverage" });
             }
             let mut mask = vec![false; coverage.len()];
-            crate::visibility::binary_into(coverage, &mut mask);
+            crate::rsl::visibility::binary_into(coverage, &mut mask);
             Self::build(w, h, &mask)
         }
 

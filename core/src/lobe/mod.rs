@@ -19,6 +19,11 @@
 //!
 //! **Integral.** [`integral`] is within [`INTEGRAL_REL_ERROR`] relative (two roundings).
 
+pub mod brdf;
+pub mod cap;
+pub mod product;
+pub mod sum;
+
 use crate::frame::{Frame, check_dir};
 use crate::math;
 use crate::{Error, TWO_PI, Vec3};

@@ -2,7 +2,7 @@
 //!
 //! For a view direction `wₒ`, the table holds the texel integrals
 //! `t(i, j) = ∫_texel ρ(wᵢ, wₒ)·cos θᵢ dωᵢ` over the equal-area parametrisation square of
-//! incident directions ([`crate::hemisphere`]: disk point `p ∈ [−1, 1]²`, texel `(i, j)` of an
+//! incident directions ([`crate::rsl::hemisphere`]: disk point `p ∈ [−1, 1]²`, texel `(i, j)` of an
 //! `n × n` grid covers `p ∈ [−1 + 2i/n, −1 + 2(i+1)/n] × …`, `dω = 2·du·dv`, zero outside the
 //! unit disk), summed into a [`Sat`]. The integral of the cosine-weighted BRDF over a square
 //! of the parametrisation plane — the paper's BRDF integral over an RSL, with the cosine
@@ -77,10 +77,10 @@
 
 use alloc::vec::Vec;
 
-use crate::brdf::Brdf;
-use crate::hemisphere;
+use crate::lobe::brdf::Brdf;
 use crate::math;
-use crate::sat::Sat;
+use crate::rsl::hemisphere;
+use crate::rsl::sat::Sat;
 use crate::{Error, TWO_PI, Vec2, Vec3};
 
 /// Grid size and view sampling of a [`BrdfSat`].
@@ -730,7 +730,7 @@ impl BrdfSat {
     /// parametrisation area, `φ = 2·ρ·cos θᵢ` (disk units), fitted as a plane over the
     /// square: `g = (I_right − I_left, I_top − I_bottom)/(2h³)` with `h` the half-side, exact
     /// for a linear `φ` (for the shading with visibility moments,
-    /// [`crate::shade::shade_moments`]). Three box queries per table instead of one. The
+    /// [`crate::rsl::shade::shade_moments`]). Three box queries per table instead of one. The
     /// integral is [`BrdfSat::integral`]'s up to `f32` rounding (it is recombined from the
     /// same tables in `f64`). NaN input gives NaN; a view on or below the horizon gives 0.
     pub fn integral_gradient(
@@ -747,7 +747,7 @@ impl BrdfSat {
         }
         let n = self.locate(wo_local, centre);
         let (k0, t, tc) = (n.k0, f64::from(n.t), n.tc);
-        let h = crate::sat::square_half_side(half_diagonal) * n.half_n;
+        let h = crate::rsl::sat::square_half_side(half_diagonal) * n.half_n;
         // [whole, right − left, top − bottom] of one table around `tc` (texel units).
         let parts = |k: usize| -> [f64; 3] {
             let v = self.sats[k].view();
@@ -843,7 +843,7 @@ impl SplitMix {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::brdf::{Lambert, Phong};
+    use crate::lobe::brdf::{Lambert, Phong};
 
     #[test]
     fn whole_hemisphere_is_the_albedo() {

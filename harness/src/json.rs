@@ -1,0 +1,93 @@
+//! The JSON helpers of `steradian eval`: reading validated numbers and vectors from an input
+//! line, and printing an `f32` as the shortest decimal that reads back to it. Every eval
+//! kernel parses its line with these, so a bad line gets the same kind of message whatever
+//! the kernel.
+
+use serde_json::{Map, Value};
+use steradian_core::Vec3;
+
+/// An f32 as a JSON number with the shortest round-tripping decimal.
+pub fn num(x: f32) -> Value {
+    let short: f64 = format!("{x}").parse().unwrap_or(f64::NAN);
+    serde_json::Number::from_f64(short).map_or(Value::Null, Value::Number)
+}
+
+/// Field `name` of `obj`, or the error message for a missing field.
+pub fn field<'a>(obj: &'a Map<String, Value>, name: &str) -> Result<&'a Value, String> {
+    obj.get(name)
+        .ok_or_else(|| format!("missing field \"{name}\""))
+}
+
+/// `v` as a finite `f32`; `name` is the field it came from.
+pub fn finite_f32(v: &Value, name: &str) -> Result<f32, String> {
+    let x = v
+        .as_f64()
+        .ok_or_else(|| format!("field \"{name}\" must be a number"))?;
+    let f = x as f32;
+    if !f.is_finite() {
+        return Err(format!("field \"{name}\" = {x} is not a finite f32"));
+    }
+    Ok(f)
+}
+
+/// Field `name` of `obj` as a finite f32, or the error message for the line.
+pub fn number(obj: &Map<String, Value>, name: &str) -> Result<f32, String> {
+    finite_f32(field(obj, name)?, name)
+}
+
+/// Field `name` of `obj` as `N` finite `f32`s.
+pub fn vector<const N: usize>(obj: &Map<String, Value>, name: &str) -> Result<[f32; N], String> {
+    let arr = field(obj, name)?
+        .as_array()
+        .ok_or_else(|| format!("field \"{name}\" must be an array of {N} numbers"))?;
+    if arr.len() != N {
+        return Err(format!(
+            "field \"{name}\" must have {N} components, got {}",
+            arr.len()
+        ));
+    }
+    let mut out = [0f32; N];
+    for (o, v) in out.iter_mut().zip(arr) {
+        *o = finite_f32(v, name)?;
+    }
+    Ok(out)
+}
+
+/// `v` as a vector, or the error message if it is zero.
+pub fn nonzero(v: [f32; 3], name: &str) -> Result<Vec3, String> {
+    let v = Vec3::from(v);
+    if v == Vec3::ZERO {
+        return Err(format!("field \"{name}\" must not be the zero vector"));
+    }
+    Ok(v)
+}
+
+/// Field `"exponent"` as a finite `f32 ≥ 0`.
+pub fn exponent(obj: &Map<String, Value>) -> Result<f32, String> {
+    let e = number(obj, "exponent")?;
+    if e < 0.0 {
+        return Err(format!("exponent = {e} must be ≥ 0"));
+    }
+    Ok(e)
+}
+
+/// Field `"scale"` as a finite `f32`, 1 when absent.
+pub fn scale(obj: &Map<String, Value>) -> Result<f32, String> {
+    match obj.get("scale") {
+        None => Ok(1.0),
+        Some(v) => finite_f32(v, "scale"),
+    }
+}
+
+/// An array element (or other value) as a finite `f32`; `what` names it in the error
+/// (`queries[2][1] must be a number, got "x"`).
+pub fn element_f32(v: &Value, what: &str) -> Result<f32, String> {
+    let x = v
+        .as_f64()
+        .ok_or_else(|| format!("{what} must be a number, got {v}"))?;
+    let f = x as f32;
+    if !f.is_finite() {
+        return Err(format!("{what} = {x} is not a finite f32"));
+    }
+    Ok(f)
+}

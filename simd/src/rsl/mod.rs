@@ -1,0 +1,8 @@
+//! The kernels of the rotatable-square-lights paper, 8 lanes at a time (mirrors
+//! `steradian_core::rsl`): the equal-area hemisphere map, summed-area and visibility
+//! distance table queries, and the shading kernels.
+
+pub mod hemisphere;
+pub mod sat;
+pub mod shade;
+pub mod vdt;
