@@ -6,7 +6,7 @@
 
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use steradian_harness::backend::{self, Backend};
-use steradian_harness::kernels::{Columns, Kernel};
+use steradian_harness::kernels::Columns;
 use steradian_harness::{report, workload};
 
 const N: usize = 1 << 16;
@@ -28,7 +28,7 @@ fn backends() -> Vec<Box<dyn Backend>> {
 fn kernels(c: &mut Criterion) {
     eprintln!("SIMD build: {}", steradian_simd::isa());
     let mut bs = backends();
-    for k in Kernel::ALL {
+    for k in steradian_harness::registry::batch_kernels() {
         let input = workload::generate(k, N, report::SEED);
         let mut out = Columns::zeros(k.output_arity(), N);
         let mut g = c.benchmark_group(k.name());

@@ -5,26 +5,21 @@ use serde::Serialize;
 use crate::kernels::{Columns, Kernel};
 use crate::reference;
 
-/// Name of the error metric of a kernel (as in `report.json`).
+/// Name of the error metric of a kernel (as in `report.json`; from the registry).
 pub fn metric(kernel: Kernel) -> &'static str {
-    match kernel {
-        Kernel::HemisphereMap | Kernel::HemisphereUnmap => "abs",
-        Kernel::LobeEval => "rel/κ",
-        Kernel::LobeIntegral => "rel",
-        Kernel::CapExponent => "excess-L2-rel",
+    match crate::registry::of(kernel).bound {
+        crate::registry::Piece::At(b) => b.metric,
+        crate::registry::Piece::Without(_) => "none",
     }
 }
 
-/// The documented bound of a kernel in its metric.
+/// The documented bound of a kernel in its metric (from the registry).
 pub fn bound(kernel: Kernel) -> f64 {
-    use steradian_core::{lobe, lobe::cap, rsl::hemisphere};
-    match kernel {
-        Kernel::HemisphereMap => hemisphere::MAP_ABS_ERROR as f64,
-        Kernel::HemisphereUnmap => hemisphere::UNMAP_ABS_ERROR as f64,
-        Kernel::LobeEval => lobe::EVAL_REL_ERROR as f64,
-        Kernel::LobeIntegral => lobe::INTEGRAL_REL_ERROR as f64,
-        Kernel::CapExponent => cap::EXCESS_L2_REL,
-    }
+    crate::registry::of(kernel)
+        .bound
+        .get()
+        .and_then(|b| b.value)
+        .unwrap_or(f64::NAN)
 }
 
 /// The lobe-eval metric `|c − c*| / (|c*|·κ)` with

@@ -10,45 +10,8 @@
 use std::io::{BufRead, Write};
 
 use serde_json::{Value, json};
-use steradian_core::{Vec2, lobe, lobe::cap, rsl::hemisphere};
 
-use crate::json::{exponent, nonzero, num, number, scale, vector};
-
-/// The kernels `eval` accepts, with their input and output, for `--help` and errors.
-pub const KERNELS: &[(&str, &str)] = &[
-    (
-        "lobe-integral",
-        r#"{"exponent": e, "scale": s (default 1)} -> {"integral": 2πs/(e+1)}"#,
-    ),
-    (
-        "lobe-eval",
-        r#"{"axis": [x,y,z], "exponent": e, "scale": s (default 1), "dir": [x,y,z]} -> {"value": s·max(a·v,0)^e}"#,
-    ),
-    (
-        "cap-exponent",
-        r#"{"half_angle": α in [1e-18, π/2]} -> {"exponent": e} (L2 fit, from the table)"#,
-    ),
-    (
-        "hemisphere-map",
-        r#"{"dir": [x,y,z] with z ≥ 0, any non-zero length} -> {"p": [u,v]}"#,
-    ),
-    (
-        "hemisphere-unmap",
-        r#"{"p": [u,v] with u²+v² ≤ 1} -> {"dir": [x,y,z]}"#,
-    ),
-    (
-        "lobe-product",
-        r#"{"e1": e1, "e2": e2, "alpha": α} -> {"scale": p, "exponent": e_r, "axis_angle": β, "integral": 2πp/(e_r+1)} (unit lobes, a1 = +z, a2 toward +x)"#,
-    ),
-    (
-        "sat-box",
-        r#"{"grid": [[t00, t10, …], …] (rows in v), "queries": [[u0, v0, u1, v1], …] (texel units)} -> {"values": [∫ over each box]}"#,
-    ),
-    (
-        "vdt-box",
-        r#"{"mask": ["0110…", …] rows of '0'/'1' ('1' visible, row j along v), "queries": [[u, v, r], …] centre and half-diagonal in texel units} -> {"values": [visible fraction, eq. 9], "values_gradient": [straight-edge variant]}"#,
-    ),
-];
+use crate::registry;
 
 /// Evaluates one input line of `kernel`; `Err` is the message for `{"error": ...}`.
 pub fn eval_line(kernel: &str, line: &str) -> Result<Value, String> {
@@ -56,56 +19,26 @@ pub fn eval_line(kernel: &str, line: &str) -> Result<Value, String> {
     let obj = v
         .as_object()
         .ok_or_else(|| "each line must be a JSON object".to_string())?;
-    match kernel {
-        "sat-box" => crate::sat::eval_sat_box(obj),
-        "lobe-product" => crate::product::eval_lobe_product(obj),
-        "lobe-integral" => {
-            let (e, s) = (exponent(obj)?, scale(obj)?);
-            Ok(json!({ "integral": num(lobe::integral(e, s)) }))
-        }
-        "lobe-eval" => {
-            let l = lobe::CosineLobe::new(
-                nonzero(vector::<3>(obj, "axis")?, "axis")?,
-                scale(obj)?,
-                exponent(obj)?,
-            )
-            .map_err(|e| e.to_string())?;
-            let d =
-                steradian_core::frame::normalize_or_zero(nonzero(vector::<3>(obj, "dir")?, "dir")?);
-            Ok(json!({ "value": num(l.eval(d)) }))
-        }
-        "cap-exponent" => {
-            let a = number(obj, "half_angle")?;
-            let (lo, hi) = cap::DOMAIN;
-            if !(lo..=hi).contains(&a) {
-                return Err(format!(
-                    "half_angle = {a} is outside [{lo:e}, {hi}] (radians)"
-                ));
-            }
-            Ok(json!({ "exponent": num(cap::exponent_l2(a)) }))
-        }
-        "hemisphere-map" => {
-            let d = nonzero(vector::<3>(obj, "dir")?, "dir")?;
-            if d.z < 0.0 {
-                return Err(format!("dir has z = {} < 0: below the hemisphere", d.z));
-            }
-            let p = hemisphere::map(d);
-            Ok(json!({ "p": [num(p.x), num(p.y)] }))
-        }
-        "hemisphere-unmap" => {
-            let [u, v] = vector::<2>(obj, "p")?;
-            let r2 = u as f64 * u as f64 + v as f64 * v as f64;
-            if r2 > 1.0 {
-                return Err(format!(
-                    "p = [{u}, {v}] is outside the unit disk (|p|² = {r2})"
-                ));
-            }
-            let d = hemisphere::unmap(Vec2::new(u, v));
-            Ok(json!({ "dir": [num(d.x), num(d.y), num(d.z)] }))
-        }
-        "vdt-box" => crate::vdt::eval_vdt_box(obj),
-        other => Err(format!("unknown kernel {other}")),
+    match registry::find(kernel).and_then(|k| k.eval.get()) {
+        Some(handler) => handler(obj),
+        None => Err(format!("unknown kernel {kernel}")),
     }
+}
+
+/// Whether `eval` has a handler for `kernel`.
+pub fn accepts(kernel: &str) -> bool {
+    registry::find(kernel).is_some_and(|k| k.eval.get().is_some())
+}
+
+/// The help text: every kernel `eval` accepts with its input and output (from the registry).
+pub fn help() -> String {
+    let mut s = String::from("Kernels:\n");
+    for k in registry::KERNELS {
+        if k.eval.get().is_some() {
+            s += &format!("  {:<17} {}\n", k.name, k.contract);
+        }
+    }
+    s + "A bad line gets {\"error\": \"...\"} and the run goes on; the exit status is 1 if any line erred."
 }
 
 /// Runs `kernel` over every line of `input`, writing one JSON line per input line (blank
@@ -130,6 +63,7 @@ pub fn run(kernel: &str, input: impl BufRead, mut output: impl Write) -> std::io
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::json::num;
 
     fn one(kernel: &str, line: &str) -> Value {
         let mut out = Vec::new();

@@ -31,7 +31,7 @@ impl Kernel {
     ];
 
     /// The kernel's name (`hemisphere-map`, …).
-    pub fn name(self) -> &'static str {
+    pub const fn name(self) -> &'static str {
         match self {
             Kernel::HemisphereMap => "hemisphere-map",
             Kernel::HemisphereUnmap => "hemisphere-unmap",

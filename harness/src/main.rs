@@ -55,11 +55,7 @@ enum Command {
 }
 
 fn eval_help() -> String {
-    let mut s = String::from("Kernels:\n");
-    for (k, contract) in eval::KERNELS {
-        s += &format!("  {k:<17} {contract}\n");
-    }
-    s + "A bad line gets {\"error\": \"...\"} and the run goes on; the exit status is 1 if any line erred."
+    eval::help()
 }
 
 fn main() -> ExitCode {
@@ -95,7 +91,7 @@ fn main() -> ExitCode {
             }
         }
         Command::Eval { kernel } => {
-            if !eval::KERNELS.iter().any(|(k, _)| *k == kernel) {
+            if !eval::accepts(&kernel) {
                 eprintln!("steradian eval: unknown kernel {kernel:?}\n{}", eval_help());
                 return ExitCode::from(2);
             }

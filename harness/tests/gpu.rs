@@ -15,8 +15,7 @@ use steradian_harness::kernels::{Columns, Kernel};
 
 use core::f32::consts::{FRAC_PI_2, PI};
 
-#[path = "common/gpu.rs"]
-mod gpu_common;
+use crate::common::gpu as gpu_common;
 use gpu_common::gpu;
 
 /// The harness's deterministic generator, with the f32 helpers these tests want.
@@ -426,7 +425,7 @@ fn inputs(kernel: Kernel, seed: u64) -> Columns {
 #[test]
 fn kernels_match_scalar_within_documented_tolerance() {
     let Some(mut gpu) = gpu() else { return };
-    for kernel in Kernel::ALL {
+    for kernel in steradian_harness::registry::batch_kernels() {
         let input = inputs(kernel, 0x5EED ^ kernel as u64);
         let stats = check(&mut gpu, kernel, &input);
         eprintln!(
@@ -448,7 +447,7 @@ fn kernels_match_scalar_within_documented_tolerance() {
 #[test]
 fn tiny_batches_and_reuse() {
     let Some(mut gpu) = gpu() else { return };
-    for kernel in Kernel::ALL {
+    for kernel in steradian_harness::registry::batch_kernels() {
         // n = 0: no dispatch, no error
         let empty_in = Columns::zeros(kernel.input_arity(), 0);
         let mut empty_out = Columns::zeros(kernel.output_arity(), 0);
@@ -513,7 +512,7 @@ fn large_batches_fold_into_2d_and_split_into_chunks() {
 fn timing_1m() {
     let Some(mut gpu) = gpu() else { return };
     let n = 1 << 20;
-    for kernel in Kernel::ALL {
+    for kernel in steradian_harness::registry::batch_kernels() {
         let base = inputs(kernel, 11);
         let mut input = Columns::zeros(kernel.input_arity(), n);
         for c in 0..kernel.input_arity() {

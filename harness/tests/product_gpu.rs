@@ -12,8 +12,7 @@ use steradian_harness::backend::gpu_product::{
 };
 use steradian_harness::kernels::Columns;
 
-#[path = "common/gpu.rs"]
-mod gpu_common;
+use crate::common::gpu as gpu_common;
 use gpu_common::{gpu, say};
 
 /// The harness's deterministic generator, with the f32 helpers these tests want.

@@ -7,8 +7,7 @@
 use proptest::prelude::*;
 use proptest::test_runner::Config;
 
-#[path = "common/proptest_config.rs"]
-mod proptest_config;
+use crate::common::proptest_config;
 use serde_json::{Value, json};
 use steradian_core::Vec2;
 use steradian_core::rsl::sat::{Sat, SatView};
@@ -20,8 +19,7 @@ use steradian_harness::rng::Rng;
 use steradian_harness::sat::options::PlainF32;
 use steradian_harness::sat::{Grid, error_bound, gpu_box_sums, gpu_table, ulp};
 
-#[path = "common/gpu.rs"]
-mod gpu_common;
+use crate::common::gpu as gpu_common;
 use gpu_common::{gpu, say};
 
 fn config(cases: u32) -> Config {

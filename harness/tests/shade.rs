@@ -25,8 +25,7 @@ use steradian_harness::env::{self, CubeMap};
 use steradian_harness::kernels::Columns;
 use steradian_harness::shade::{self as sh, Analysis, Samples, Scene, Settings, VARIANTS, Variant};
 
-#[path = "common/gpu.rs"]
-mod gpu_common;
+use crate::common::gpu as gpu_common;
 use gpu_common::{gpu, say};
 
 /// VDT resolution of the accuracy tests (the report measures 64, 128, 256).

@@ -23,8 +23,7 @@ use steradian_harness::env::decompose::{Decomposition, Options, decompose};
 use steradian_harness::env::{self};
 use steradian_harness::shade::{self as sh, Scene, ShadePoint};
 
-#[path = "common/gpu.rs"]
-mod gpu_common;
+use crate::common::gpu as gpu_common;
 use gpu_common::{gpu, say};
 
 /// Side of the coverage maps (as the accuracy tests of `tests/shade.rs`).

@@ -7,8 +7,7 @@ use std::f64::consts::{FRAC_PI_2, PI, TAU};
 use proptest::prelude::*;
 use proptest::test_runner::Config;
 
-#[path = "common/proptest_config.rs"]
-mod proptest_config;
+use crate::common::proptest_config;
 use steradian_core::Vec3;
 use steradian_core::frame::Frame;
 use steradian_core::lobe::cap::SphericalCap;

@@ -10,8 +10,7 @@ use steradian_harness::backend::gpu::Custom;
 use steradian_harness::kernels::Columns;
 use steradian_harness::rng::Rng;
 
-#[path = "common/gpu.rs"]
-mod gpu_common;
+use crate::common::gpu as gpu_common;
 use gpu_common::{gpu, say};
 
 #[test]

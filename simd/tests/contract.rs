@@ -11,8 +11,7 @@ use steradian_simd::{LobeX8, Vec2x8, Vec3x8, f32x8, lobe, lobe::cap, rsl::hemisp
 // ---------------------------------------------------------------------------------------
 // Inputs
 
-#[path = "common/rng.rs"]
-mod rng;
+use crate::common::rng;
 use rng::Rng;
 
 impl Rng {
@@ -27,8 +26,7 @@ impl Rng {
     }
 }
 
-#[path = "common/specials.rs"]
-mod specials;
+use crate::common::specials;
 use specials::SPECIALS;
 
 /// Bit-identical, or both NaN (payloads may differ).

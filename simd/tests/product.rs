@@ -14,8 +14,7 @@ use steradian_simd::lobe::product::{
 };
 use steradian_simd::{LobeX8, Vec3x8, f32x8};
 
-#[path = "common/rng.rs"]
-mod rng;
+use crate::common::rng;
 use rng::Rng;
 
 const FITS: [ProductFit; 3] = [
@@ -266,8 +265,7 @@ fn survey_max_differences_long() {
 // ---------------------------------------------------------------------------------------
 // Named cases
 
-#[path = "common/specials.rs"]
-mod specials;
+use crate::common::specials;
 use specials::SPECIALS;
 
 /// A batch of 8 ordinary pairs from `rng`.

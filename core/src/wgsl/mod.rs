@@ -262,7 +262,7 @@ pub const ALL: [(&str, &str); 5] = [
 pub const CUSTOM: [(&str, &str, &str); 5] = [
     ("lobe-product", LOBE_PRODUCT, "f32"),
     ("sat-box", SAT_BOX, "u32"),
-    ("vdt-query", VDT_QUERY, "f32"),
+    ("vdt-box", VDT_QUERY, "f32"),
     ("shade", SHADE, "u32"),
     ("shade-moments", SHADE_MOMENTS, "u32"),
 ];

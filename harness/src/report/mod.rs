@@ -21,7 +21,8 @@ use serde::Serialize;
 
 use crate::accuracy::{self, ErrorStats};
 use crate::backend;
-use crate::kernels::{Columns, Kernel};
+use crate::kernels::Columns;
+use crate::registry;
 use crate::workload;
 
 /// Seed of the default workload.
@@ -151,13 +152,13 @@ pub fn run(opts: &Options) -> Result<Report, Box<dyn std::error::Error>> {
             Err(why) => machine.gpu_unavailable = Some(why),
         }
     }
-    let steps = (Kernel::ALL.len() * (backends.len() + 1)) as u64;
+    let steps = (registry::batch_kernels().count() * (backends.len() + 1)) as u64;
     let bar = ProgressBar::new(steps).with_style(
         ProgressStyle::with_template("{spinner} [{elapsed_precise}] {bar:30} {pos}/{len} {msg}")
             .unwrap_or_else(|_| ProgressStyle::default_bar()),
     );
     let mut results = Vec::new();
-    for k in Kernel::ALL {
+    for k in registry::batch_kernels() {
         bar.set_message(format!("{k}: inputs and f64 reference"));
         let input = workload::generate(k, opts.n, SEED);
         let reference = accuracy::reference(k, &input, opts.error_rows);
@@ -262,7 +263,7 @@ pub fn summary(r: &Report) -> String {
         );
     }
     s += "\nSIMD against the scalar rows of the same run:\n";
-    for k in Kernel::ALL {
+    for k in registry::batch_kernels() {
         let get = |b| r.get(k.name(), b).map(|row| row.evals_per_s);
         if let (Some(simd), Some(one), Some(lp)) =
             (get("cpu-simd"), get("cpu-scalar"), get("cpu-scalar-loop"))

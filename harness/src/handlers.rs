@@ -1,0 +1,62 @@
+//! The `steradian eval` handlers of the kernels that need no table of the caller: one
+//! function per kernel, a validated input line in, its JSON answer out. The table-driven
+//! kernels keep theirs beside their harness code (`product`, `sat`, `vdt`); the registry
+//! (`crate::registry`) names each kernel's handler.
+
+use serde_json::{Map, Value, json};
+use steradian_core::{Vec2, lobe, lobe::cap, rsl::hemisphere};
+
+use crate::json::{exponent, nonzero, num, number, scale, vector};
+
+/// `lobe-integral`: `{"exponent": e, "scale": s}` → `{"integral": 2πs/(e+1)}`.
+pub fn lobe_integral(obj: &Map<String, Value>) -> Result<Value, String> {
+    let (e, s) = (exponent(obj)?, scale(obj)?);
+    Ok(json!({ "integral": num(lobe::integral(e, s)) }))
+}
+
+/// `lobe-eval`: `{"axis", "exponent", "scale", "dir"}` → `{"value": s·max(a·v, 0)^e}`.
+pub fn lobe_eval(obj: &Map<String, Value>) -> Result<Value, String> {
+    let l = lobe::CosineLobe::new(
+        nonzero(vector::<3>(obj, "axis")?, "axis")?,
+        scale(obj)?,
+        exponent(obj)?,
+    )
+    .map_err(|e| e.to_string())?;
+    let d = steradian_core::frame::normalize_or_zero(nonzero(vector::<3>(obj, "dir")?, "dir")?);
+    Ok(json!({ "value": num(l.eval(d)) }))
+}
+
+/// `cap-exponent`: `{"half_angle": α}` → `{"exponent": e}` (the table's L2 fit).
+pub fn cap_exponent(obj: &Map<String, Value>) -> Result<Value, String> {
+    let a = number(obj, "half_angle")?;
+    let (lo, hi) = cap::DOMAIN;
+    if !(lo..=hi).contains(&a) {
+        return Err(format!(
+            "half_angle = {a} is outside [{lo:e}, {hi}] (radians)"
+        ));
+    }
+    Ok(json!({ "exponent": num(cap::exponent_l2(a)) }))
+}
+
+/// `hemisphere-map`: `{"dir": [x, y, z]}` (z ≥ 0) → `{"p": [u, v]}`.
+pub fn hemisphere_map(obj: &Map<String, Value>) -> Result<Value, String> {
+    let d = nonzero(vector::<3>(obj, "dir")?, "dir")?;
+    if d.z < 0.0 {
+        return Err(format!("dir has z = {} < 0: below the hemisphere", d.z));
+    }
+    let p = hemisphere::map(d);
+    Ok(json!({ "p": [num(p.x), num(p.y)] }))
+}
+
+/// `hemisphere-unmap`: `{"p": [u, v]}` (inside the unit disk) → `{"dir": [x, y, z]}`.
+pub fn hemisphere_unmap(obj: &Map<String, Value>) -> Result<Value, String> {
+    let [u, v] = vector::<2>(obj, "p")?;
+    let r2 = u as f64 * u as f64 + v as f64 * v as f64;
+    if r2 > 1.0 {
+        return Err(format!(
+            "p = [{u}, {v}] is outside the unit disk (|p|² = {r2})"
+        ));
+    }
+    let d = hemisphere::unmap(Vec2::new(u, v));
+    Ok(json!({ "dir": [num(d.x), num(d.y), num(d.z)] }))
+}

@@ -1,0 +1,19 @@
+//! The harness's integration tests, one binary (as `wide` does): one module per subsystem,
+//! sharing `common` (the GPU adapter helper and the proptest configuration). One binary
+//! links wgpu, naga and image once instead of once per file.
+
+mod brdf;
+mod common;
+mod coverage;
+mod env;
+mod gpu;
+mod lobe_sum;
+mod product;
+mod product_gpu;
+mod properties;
+mod sat;
+mod shade;
+mod shade_moments_gpu;
+mod vdt;
+mod vdt_gpu;
+mod wgsl_validate;
