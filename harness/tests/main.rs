@@ -5,6 +5,7 @@
 mod brdf;
 mod common;
 mod coverage;
+mod cycles;
 mod env;
 mod gpu;
 mod lobe_sum;

@@ -77,6 +77,10 @@
 
 #[cfg(feature = "alloc")]
 pub mod brdf_sat;
+#[cfg(feature = "alloc")]
+pub mod cubemap;
+#[cfg(feature = "alloc")]
+pub mod decompose;
 pub mod hemisphere;
 pub mod sat;
 pub mod shade;

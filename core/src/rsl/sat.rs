@@ -144,7 +144,8 @@ fn quantum_exponent(abs_sum: f64) -> i32 {
 
 /// One axis of a box: the ordered, clipped interval `[lo, hi]` of `[0, n]` as
 /// `(I0, a0, I1, a1)` with `lo = I0 + a0`, `hi = I1 + a1`, `0 ≤ I ≤ n − 1`, `0 ≤ a ≤ 1`.
-/// The corners must not be NaN. Every step is exact.
+/// The corners must not be NaN. Every step is exact. An empty axis (`n = 0`) gives
+/// `(0, 0, 0, 0)`.
 ///
 /// Spelled with comparisons and selects only (no `f32::min`/`max`, which may return either
 /// zero of `±0`), so that the SIMD kernel can repeat it bit for bit.
@@ -162,13 +163,21 @@ pub fn axis(c0: f32, c1: f32, n: usize) -> (usize, f32, usize, f32) {
     };
     let (lo, hi) = if c1 < c0 { (c1, c0) } else { (c0, c1) };
     let (lo, hi) = (clip(lo), clip(hi));
-    let last = (n - 1) as f32;
+    let last = n.saturating_sub(1) as f32;
     let floor_min = |x: f32| {
         let f = math::floorf(x);
         if f > last { last } else { f }
     };
     let (i0, i1) = (floor_min(lo), floor_min(hi));
     (index(i0), lo - i0, index(i1), hi - i1)
+}
+
+/// The entries of table row `l` (rows of `w1` entries), or `None` where the range
+/// overflows `usize` (such a row is past any table; the callers read it as zeros).
+#[inline(always)]
+fn row_range(l: usize, w1: usize) -> Option<core::ops::Range<usize>> {
+    let start = l.checked_mul(w1)?;
+    Some(start..start.checked_add(w1)?)
 }
 
 /// An exact integer `0 ≤ x < 2³²` in an `f32` as a `usize` (NaN gives 0, as `x as usize`
@@ -411,7 +420,7 @@ impl<'a> SatView<'a> {
         let w = self.width;
         let w1 = w + 1;
         let (i0, i1) = (i0.min(w), i1.min(w));
-        let row = |l: usize| self.sums.get(l * w1..l * w1 + w1);
+        let row = |l: usize| self.sums.get(row_range(l, w1)?);
         match (row(j0), row(j1)) {
             (Some(r0), Some(r1)) => r1[i1]
                 .wrapping_sub(r1[i0])
@@ -467,18 +476,28 @@ impl<'a> SatView<'a> {
         let w1 = w + 1;
         // Integer facts that let the compiler drop the per-entry bounds checks: every
         // index below is then provably inside `r` (`i + 1 ≤ w < w1 = r.len()`).
-        let (i0, i1) = (i0.min(w - 1), i1.min(w - 1));
+        let (i0, i1) = (i0.min(w.saturating_sub(1)), i1.min(w.saturating_sub(1)));
         // Per row: [S(I0), S(I0+1), S(I1), S(I1+1)] (one range check per row; a row past
         // the table, which the callers never ask for, reads as zeros).
         let row = |l: usize| -> [i64; 4] {
-            match self.sums.get(l * w1..l * w1 + w1) {
-                Some(r) => [r[i0], r[i0 + 1], r[i1], r[i1 + 1]],
-                None => [0; 4],
+            match row_range(l, w1).and_then(|range| self.sums.get(range)) {
+                Some(r) if r.len() > i1 + 1 && r.len() > i0 + 1 => {
+                    [r[i0], r[i0 + 1], r[i1], r[i1 + 1]]
+                }
+                _ => [0; 4],
             }
         };
         let (r0, r1) = (row(j0), row(j1));
-        let r0p = if b0 != 0.0 { row(j0 + 1) } else { r0 };
-        let r1p = if b1 != 0.0 { row(j1 + 1) } else { r1 };
+        let r0p = if b0 != 0.0 {
+            row(j0.saturating_add(1))
+        } else {
+            r0
+        };
+        let r1p = if b1 != 0.0 {
+            row(j1.saturating_add(1))
+        } else {
+            r1
+        };
         // [P, E1, E0] between rows l and m, each the difference of the per-row differences.
         let d = |l: [i64; 4], m: [i64; 4]| -> [i64; 3] {
             let p = m[2]
@@ -793,5 +812,36 @@ mod tests {
         assert_eq!(ceil_log2(1.5), 1);
         assert_eq!(ceil_log2(0.25), -2);
         assert_eq!(pow2(-3), 0.125);
+    }
+
+    #[test]
+    fn axis_of_an_empty_grid_is_zero_and_does_not_overflow() {
+        assert_eq!(axis(-1.0, 5.0, 0), (0, 0.0, 0, 0.0));
+        assert_eq!(axis(0.0, 0.0, 0), (0, 0.0, 0, 0.0));
+        assert_eq!(axis(3.0, -2.0, 1), (0, 0.0, 0, 1.0));
+    }
+
+    #[test]
+    fn index_arithmetic_at_the_extremes_never_panics() {
+        let t: Vec<f32> = (0..12).map(|k| k as f32).collect();
+        let sat = Sat::build(4, 3, &t).unwrap();
+        let view = sat.view();
+        let m = usize::MAX;
+        // Rows past the table (including those whose offset overflows usize) read as zero.
+        assert_eq!(view.integer_box(0, m, m, m), 0);
+        assert_eq!(view.integer_box(m, m, 0, m), 0);
+        assert_eq!(view.integer_box(0, 4, 0, 3), view.integer_box(0, m, 0, 3));
+        let _ = view.integer_terms((m, m), (m, m), (0.5, 0.5));
+        let _ = view.integer_terms((0, m), (m - 1, m), (0.0, 0.5));
+        // Integer corners anywhere, in any order, clip to the table.
+        let all = view.box_sum_cells(0, 0, 4, 3);
+        assert_eq!(all, 66.0);
+        assert_eq!(view.box_sum_cells(m, m, 0, 0), all);
+        assert_eq!(view.box_sum_cells(0, m, m, 0), all);
+        assert_eq!(view.box_sum(f32::MAX, f32::MAX, -f32::MAX, -f32::MAX), all);
+        // Zero-size and oversized grids are refused, not indexed.
+        assert!(Sat::build(0, 0, &[]).is_err());
+        assert!(Sat::build(MAX_SIDE + 1, 1, &[]).is_err());
+        assert!(Sat::build(m, m, &[]).is_err());
     }
 }

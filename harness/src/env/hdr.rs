@@ -142,6 +142,6 @@ impl Equirect {
         let src = PI / self.height as f64;
         let cube = 0.5 * PI / n as f64;
         let sub = ((2.0 * cube / src).ceil() as usize).clamp(1, 32);
-        CubeMap::from_fn(n, sub, |d| self.sample_bilinear(d))
+        CubeMap::from_fn(n, sub, |d| self.sample_bilinear(d)).map_err(EnvError::from)
     }
 }

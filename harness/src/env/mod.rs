@@ -50,6 +50,14 @@ impl fmt::Display for EnvError {
 
 impl std::error::Error for EnvError {}
 
+impl From<steradian_core::rsl::cubemap::EnvError> for EnvError {
+    fn from(e: steradian_core::rsl::cubemap::EnvError) -> Self {
+        match e {
+            steradian_core::rsl::cubemap::EnvError::Invalid(s) => EnvError::Invalid(s),
+        }
+    }
+}
+
 /// The default environment: [`Sky::default`] as a cube map of face size `n`.
 pub fn default_sky(n: usize) -> Result<CubeMap, EnvError> {
     Sky::default().cubemap(n)

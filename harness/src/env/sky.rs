@@ -83,6 +83,6 @@ impl Sky {
     /// the sun: the test `default_sky_cubemap_matches_its_analytic_integral` states the
     /// measured error).
     pub fn cubemap(&self, n: usize) -> Result<CubeMap, EnvError> {
-        CubeMap::from_fn(n, 16, |d| self.radiance(d))
+        CubeMap::from_fn(n, 16, |d| self.radiance(d)).map_err(EnvError::from)
     }
 }

@@ -17,7 +17,7 @@ use steradian_core::rsl::brdf_sat::{BrdfSat, FitOptions};
 use steradian_core::{Vec2, Vec3, rsl::hemisphere};
 
 use super::Options;
-use super::sections::Section;
+use super::section::Section;
 use crate::reference::brdf::{self as rb, Model};
 use crate::rng::Rng;
 

@@ -28,7 +28,7 @@ use steradian_core::lobe::{CosineLobe, Phong};
 
 use super::Options;
 use super::plot::{Pt, Scale, Series, chart};
-use super::sections::Section;
+use super::section::Section;
 use crate::reference::triple::{self as reference, Cap, Lobe, Scene, Term, Visibility};
 use crate::rng::Rng;
 

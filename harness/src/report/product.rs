@@ -16,7 +16,7 @@ use steradian_core::lobe::product::{self, ProductFit, ProductTable};
 
 use super::Options;
 use super::plot::{Pt, Scale, Series, chart};
-use super::sections::Section;
+use super::section::Section;
 use crate::generate::lobe_product;
 use crate::product::canonical_lobes;
 use crate::reference::product::{coplanar_triple, ln_product_integral, product_integral};

@@ -13,7 +13,7 @@ use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use serde_json::json;
 
 use super::Options;
-use super::sections::Section;
+use super::section::Section;
 use crate::env::decompose::{
     Decomposition, Objective, Options as DecOptions, PAPER_KS, decompose, decompose_rescan,
 };

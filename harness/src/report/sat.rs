@@ -14,7 +14,7 @@ use serde_json::json;
 use steradian_core::rsl::sat::Sat;
 
 use super::Options;
-use super::sections::Section;
+use super::section::Section;
 use crate::backend::gpu::try_gpu;
 use crate::kernels::Columns;
 use crate::rng::Rng;

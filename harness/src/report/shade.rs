@@ -14,7 +14,7 @@ use steradian_core::lobe::brdf::Lambert;
 use steradian_core::rsl::shade::{self, ShadeLight, VdtQuery, VdtVisibility};
 
 use super::Options;
-use super::sections::Section;
+use super::section::Section;
 use crate::backend::gpu::{Custom, try_gpu};
 use crate::env::decompose::{Decomposition, Objective, Options as DecOptions, PAPER_KS, decompose};
 use crate::env::{self, CubeMap};

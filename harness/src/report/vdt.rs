@@ -18,7 +18,7 @@ use steradian_core::{Vec2, wgsl};
 
 use super::Options;
 use super::sat::{REPEATS, time};
-use super::sections::Section;
+use super::section::Section;
 use crate::backend::gpu::{Custom, try_gpu};
 use crate::kernels::Columns;
 use crate::rng::Rng;
