@@ -37,6 +37,42 @@
 //!
 //! One of `std` or `libm` must be enabled; with both, `std` is used.
 //!
+//! ## Example: one point lit by a spherical light through a Phong material
+//!
+//! The cosine-lobe paper's pipeline for one shading point: the light's cap becomes a lobe
+//! (the L2 fit of [`lobe::cap`]), the BRDF a sum of lobes with the cosine folded into the
+//! light, and the reflected radiance the integral of their products ([`lobe::sum`]).
+//!
+//! ```
+//! use steradian_core::Vec3;
+//! use steradian_core::lobe::Phong;
+//! use steradian_core::lobe::cap::{CapFit, SphericalCap};
+//! use steradian_core::lobe::sum::{Cosine, LobeSum, ProductCounts, light_with_cosine,
+//!     phong_reflectance, triple};
+//!
+//! let (point, normal) = (Vec3::ZERO, Vec3::Z);
+//! let view = Vec3::new(0.6, 0.0, 0.8); // towards the eye
+//! // A sphere of radius 0.5 at distance 4, emitting radiance 10.
+//! let cap = SphericalCap::from_sphere(point, Vec3::new(-2.0, 0.5, 3.4), 0.5)?;
+//! let mut light = LobeSum::<1>::new();
+//! light.push_cap(&cap, 10.0, CapFit::L2);
+//! let mut counts = ProductCounts::default();
+//! let light = light_with_cosine(&light, normal, Cosine::WithLight, &mut counts);
+//! // Modified Phong: diffuse 0.5, specular 0.3, exponent 50.
+//! let brdf = Phong::modified(0.5, 0.3, 50.0)?;
+//! let reflectance = phong_reflectance(&brdf, normal, view, Cosine::WithLight, &mut counts);
+//! let radiance = triple(&reflectance, &light, &LobeSum::<0>::unoccluded(), 0.0, &mut counts);
+//! // Seen as a point light of solid angle Ω in direction l, the point would reflect
+//! // f(l)·10·Ω·(n·l), with f = 0.5/π + 0.3·52/(2π)·(r·l)^50 and r the mirrored view; the
+//! // light's extent (0.13 rad, about the lobe's width) lowers the specular peak a little.
+//! let l = cap.axis();
+//! let r = steradian_core::lobe::reflect(view, normal);
+//! let f = 0.5 / steradian_core::PI + 0.3 * 52.0 / steradian_core::TWO_PI * r.dot(l).powi(50);
+//! let point_light = f * 10.0 * cap.solid_angle() * normal.dot(l);
+//! assert!((radiance / point_light - 1.0).abs() < 0.2, "{radiance} vs {point_light}");
+//! # Ok::<(), steradian_core::Error>(())
+//! ```
+//!
 //! ## GPU
 //!
 //! The WGSL sources of the kernels are in [`wgsl`] as `pub const &str`, so a renderer can
