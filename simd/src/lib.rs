@@ -1,15 +1,20 @@
 //! # steradian-simd
 //!
 //! 8-lane structure-of-arrays versions of the scalar kernels of `steradian-core`, built on
-//! [`wide::f32x8`]. Each module mirrors the core module of the same name:
+//! [`wide::f32x8`]. Each module mirrors the core module of the same path:
 //!
 //! | module | batch kernels | slice function | against the scalar kernel |
 //! |---|---|---|---|
-//! | [`hemisphere`] | [`hemisphere::map`], [`hemisphere::unmap`] | `map_slices`, `unmap_slices` | bit-identical |
+//! | [`rsl::hemisphere`] | [`rsl::hemisphere::map`], [`rsl::hemisphere::unmap`] | `map_slices`, `unmap_slices` | bit-identical |
 //! | [`lobe`] | [`lobe::integral`] | `integral_slices` | bit-identical |
 //! | [`lobe`] | [`lobe::eval`], [`lobe::eval_parts`] | `eval_slices` | within [`lobe::EVAL_REL_TOL`] |
-//! | [`cap`] | [`cap::exponent_l2`], [`cap::lookup`] | `exponent_l2_slices`, `lookup_slices` | bit-identical |
-//! | [`product`] | [`product::product_x8`] | `product_slices` | axis bit-identical; scale, exponent within [`product::SCALE_REL_TOL`] etc. |
+//! | [`lobe::cap`] | [`lobe::cap::exponent_l2`], [`lobe::cap::lookup`] | `exponent_l2_slices`, `lookup_slices` | bit-identical |
+//! | [`lobe::product`] | [`lobe::product::product_x8`] | `product_slices` | axis bit-identical; scale, exponent within [`lobe::product::SCALE_REL_TOL`] etc. |
+//! | [`rsl::sat`] | [`rsl::sat::box_sum`] | `box_sum_slices`, `square_slices` | bit-identical |
+//! | [`rsl::vdt`] | [`rsl::vdt::query`] | `query_slices` | bit-identical |
+//! | [`rsl::shade`] | [`rsl::shade::shade_x8`], [`rsl::shade::shade_moments_x8`] | `shade_batch`, `shade_moments_batch` | within [`rsl::shade::REL_TOL`], [`rsl::shade::MOMENTS_REL_TOL`] |
+//!
+//! The folders are those of `steradian-core`, one per paper (`lobe/`, `rsl/`).
 //!
 //! [`batch`] holds the lane types ([`Vec3x8`], [`Vec2x8`], [`LobeX8`]), their conversions
 //! from and to slices of the scalar types (a short slice is padded with a documented value),
