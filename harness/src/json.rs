@@ -18,16 +18,30 @@ pub fn field<'a>(obj: &'a Map<String, Value>, name: &str) -> Result<&'a Value, S
         .ok_or_else(|| format!("missing field \"{name}\""))
 }
 
-/// `v` as a finite `f32`; `name` is the field it came from.
-pub fn finite_f32(v: &Value, name: &str) -> Result<f32, String> {
-    let x = v
-        .as_f64()
-        .ok_or_else(|| format!("field \"{name}\" must be a number"))?;
+/// The one number parser of `eval`: `v` as a finite `f32`, or the message `not_a_number`
+/// (when `v` is not a JSON number) or `non_finite(x)` (when it overflows `f32`) gives.
+/// The helpers below and the kernels' own parsers (`sat-box`, `vdt-box`) differ only in
+/// their messages.
+pub fn parse_f32(
+    v: &Value,
+    not_a_number: impl FnOnce() -> String,
+    non_finite: impl FnOnce(f64) -> String,
+) -> Result<f32, String> {
+    let x = v.as_f64().ok_or_else(not_a_number)?;
     let f = x as f32;
     if !f.is_finite() {
-        return Err(format!("field \"{name}\" = {x} is not a finite f32"));
+        return Err(non_finite(x));
     }
     Ok(f)
+}
+
+/// `v` as a finite `f32`; `name` is the field it came from.
+pub fn finite_f32(v: &Value, name: &str) -> Result<f32, String> {
+    parse_f32(
+        v,
+        || format!("field \"{name}\" must be a number"),
+        |x| format!("field \"{name}\" = {x} is not a finite f32"),
+    )
 }
 
 /// Field `name` of `obj` as a finite f32, or the error message for the line.
@@ -82,12 +96,9 @@ pub fn scale(obj: &Map<String, Value>) -> Result<f32, String> {
 /// An array element (or other value) as a finite `f32`; `what` names it in the error
 /// (`queries[2][1] must be a number, got "x"`).
 pub fn element_f32(v: &Value, what: &str) -> Result<f32, String> {
-    let x = v
-        .as_f64()
-        .ok_or_else(|| format!("{what} must be a number, got {v}"))?;
-    let f = x as f32;
-    if !f.is_finite() {
-        return Err(format!("{what} = {x} is not a finite f32"));
-    }
-    Ok(f)
+    parse_f32(
+        v,
+        || format!("{what} must be a number, got {v}"),
+        |x| format!("{what} = {x} is not a finite f32"),
+    )
 }

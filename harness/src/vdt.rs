@@ -15,7 +15,7 @@ use steradian_core::rsl::vdt::Vdt;
 use steradian_core::rsl::visibility::{self, Outside};
 use steradian_core::{Vec2, Vec3};
 
-use crate::json::num;
+use crate::json::{num, parse_f32};
 use crate::rng::Rng;
 
 /// `±√d2` rounded to `f32` (`+` visible), or `±NO_BOUNDARY` for `d2 = ∞` (no boundary).
@@ -701,14 +701,11 @@ pub fn eval_vdt_box(obj: &Map<String, Value>) -> Result<Value, String> {
             .ok_or_else(|| format!("query {k} must be [u, v, r]"))?;
         let mut x = [0f32; 3];
         for (o, val) in x.iter_mut().zip(a) {
-            let f = val
-                .as_f64()
-                .ok_or_else(|| format!("query {k}: components must be numbers"))?;
-            let f32v = f as f32;
-            if !f32v.is_finite() {
-                return Err(format!("query {k}: {f} is not a finite f32"));
-            }
-            *o = f32v;
+            *o = parse_f32(
+                val,
+                || format!("query {k}: components must be numbers"),
+                |f| format!("query {k}: {f} is not a finite f32"),
+            )?;
         }
         if x[2] < 0.0 {
             return Err(format!("query {k}: half-diagonal r = {} must be ≥ 0", x[2]));
