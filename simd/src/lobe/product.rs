@@ -519,3 +519,19 @@ pub fn product_slices(
         [ox, oy, oz, out_scale, out_exponent],
     );
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn log_constants_are_the_logarithms_they_stand_for() {
+        // The constants replace `TAU.ln()` and `(2.0 * TAU).ln()` so that the crate needs no
+        // std float functions; they must be the same bits.
+        assert_eq!(LN_TAU.to_bits(), TAU.ln().to_bits());
+        assert_eq!(LN_2TAU.to_bits(), (2.0 * TAU).ln().to_bits());
+        // And the correctly rounded logarithms of the f32 values (checked in f64).
+        assert_eq!(LN_TAU, (TAU as f64).ln() as f32);
+        assert_eq!(LN_2TAU, ((2.0 * TAU) as f64).ln() as f32);
+    }
+}
