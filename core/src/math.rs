@@ -53,44 +53,13 @@ shim! {
     atan2f(f32, x2) => atan2, atan2f;
     ceilf(f32) => ceil, ceilf;
     floorf(f32) => floor, floorf;
-    // f64 for table builders and statistics, not hot paths.
+    // f64 for table builders, statistics and the environment decomposition, not hot paths.
     sqrt64(f64) => sqrt, sqrt;
     cbrt64(f64) => cbrt, cbrt;
     sin64(f64) => sin, sin;
     cos64(f64) => cos, cos;
     atan2_64(f64, x2) => atan2, atan2;
     floor64(f64) => floor, floor;
-}
-
-/// The `f64` methods of the environment decomposition (`rsl::cubemap`, `rsl::decompose`,
-/// table builders, not hot paths) without the standard library: with `std` the inherent
-/// methods are used, otherwise this trait routes them through the shim above.
-#[cfg(not(feature = "std"))]
-pub(crate) trait F64Ext {
-    fn sqrt(self) -> f64;
-    fn sin(self) -> f64;
-    fn cos(self) -> f64;
-    fn atan2(self, x: f64) -> f64;
-    fn floor(self) -> f64;
-}
-
-#[cfg(not(feature = "std"))]
-impl F64Ext for f64 {
-    fn sqrt(self) -> f64 {
-        sqrt64(self)
-    }
-    fn sin(self) -> f64 {
-        sin64(self)
-    }
-    fn cos(self) -> f64 {
-        cos64(self)
-    }
-    fn atan2(self, x: f64) -> f64 {
-        atan2_64(self, x)
-    }
-    fn floor(self) -> f64 {
-        floor64(self)
-    }
 }
 
 pub use imp::*;

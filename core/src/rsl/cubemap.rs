@@ -21,8 +21,7 @@ use core::fmt;
 
 use glam::DVec3;
 
-#[cfg(not(feature = "std"))]
-use crate::math::F64Ext;
+use crate::math;
 
 /// What was wrong with an environment or with a decomposition request.
 #[derive(Clone, Debug, PartialEq)]
@@ -59,7 +58,7 @@ pub const DEFAULT_N: usize = 32;
 /// Solid angle of `[0, a] × [0, b]` on the plane at unit distance (signed).
 #[inline]
 fn corner_solid_angle(a: f64, b: f64) -> f64 {
-    (a * b).atan2((a * a + b * b + 1.0).sqrt())
+    math::atan2_64(a * b, math::sqrt64(a * a + b * b + 1.0))
 }
 
 /// Exact solid angle of the face rectangle `[a0, a1] × [b0, b1]`.
@@ -244,7 +243,7 @@ impl CubeMap {
     pub fn dir_to_texel(&self, d: DVec3) -> usize {
         let (f, a, b) = dir_to_face(d);
         let n = self.n;
-        let to = |x: f64| (((x + 1.0) * 0.5 * n as f64).floor().max(0.0) as usize).min(n - 1);
+        let to = |x: f64| (math::floor64((x + 1.0) * 0.5 * n as f64).max(0.0) as usize).min(n - 1);
         (f * n + to(b)) * n + to(a)
     }
     /// The four edge neighbours of texel `k` (−a, +a, −b, +b), across cube edges where
@@ -257,7 +256,7 @@ impl CubeMap {
         let step = |da: f64, db: f64| -> usize {
             let (a, b) = (ac + da * h, bc + db * h);
             if (-1.0..=1.0).contains(&a) && (-1.0..=1.0).contains(&b) {
-                let to = |x: f64| (((x + 1.0) / h).floor() as usize).min(n - 1);
+                let to = |x: f64| (math::floor64((x + 1.0) / h) as usize).min(n - 1);
                 (f * n + to(b)) * n + to(a)
             } else {
                 // Beyond the face edge: the point on the face's plane, seen from the centre,

@@ -111,8 +111,7 @@ use core::f64::consts::{PI, SQRT_2};
 
 use glam::DVec3;
 
-#[cfg(not(feature = "std"))]
-use crate::math::F64Ext;
+use crate::math;
 use crate::rsl::Rsl;
 use crate::rsl::cubemap::{CubeMap, EnvError};
 
@@ -124,8 +123,10 @@ pub trait Observer {
     fn seconds(&mut self) -> f64 {
         0.0
     }
-    /// One more merge done, of `total`.
-    fn merged(&mut self, _total: u64) {}
+    /// The run will make `total` merges.
+    fn start(&mut self, _total: u64) {}
+    /// One more merge done.
+    fn merged(&mut self) {}
 }
 
 /// No clock, no progress.
@@ -182,9 +183,9 @@ const LIGHT_WEIGHT: f64 = 30.0;
 pub fn bound_cost(solid_angle: f64, energy: f64, eta2: f64) -> f64 {
     let pos = |x: f64| if x > 0.0 && x.is_finite() { x } else { 0.0 };
     let s = pos(solid_angle);
-    let sv = SIGMA_V_SCALE * s.sqrt().sqrt();
-    let sr = SIGMA_RHO_SCALE * s.sqrt();
-    let sl = (s * pos(eta2)).sqrt();
+    let sv = SIGMA_V_SCALE * math::sqrt64(math::sqrt64(s));
+    let sr = SIGMA_RHO_SCALE * math::sqrt64(s);
+    let sl = math::sqrt64(s * pos(eta2));
     pos(energy) * sv * sr + LIGHT_WEIGHT * sl * (sv + sr + sv * sr)
 }
 
@@ -332,7 +333,11 @@ impl Decomposition {
     /// Relative L2 error of the luminance against its per-region average (module docs).
     pub fn piecewise_rel_l2(&self, cube: &CubeMap) -> f64 {
         let (num, den) = self.piecewise_sums(cube, |w, d| w * d * d, |w, l| w * l * l);
-        if den > 0.0 { (num / den).sqrt() } else { 0.0 }
+        if den > 0.0 {
+            math::sqrt64(num / den)
+        } else {
+            0.0
+        }
     }
 
     /// Relative L1 error of the luminance against its per-region average,
@@ -347,7 +352,11 @@ impl Decomposition {
     pub fn rsl_rel_l2(&self) -> f64 {
         let num: f64 = self.regions.iter().map(|r| r.fit.eta2).sum();
         let den: f64 = self.regions.iter().map(|r| r.luminance_sq).sum();
-        if den > 0.0 { (num / den).sqrt() } else { 0.0 }
+        if den > 0.0 {
+            math::sqrt64(num / den)
+        } else {
+            0.0
+        }
     }
 
     /// Sum of the objectives of eq. 7 over the regions.
@@ -376,7 +385,7 @@ pub fn basis(c: DVec3) -> (DVec3, DVec3) {
 #[inline]
 fn lambert(d: DVec3, t: DVec3, bt: DVec3, c: DVec3) -> (f64, f64) {
     let (x, y, z) = (d.dot(t), d.dot(bt), d.dot(c));
-    let s = (2.0_f64 / (1.0 + z).max(1e-12_f64)).sqrt();
+    let s = math::sqrt64(2.0 / (1.0 + z).max(1e-12));
     (x * s, y * s)
 }
 
@@ -500,7 +509,7 @@ impl Fitter {
                 best = Some((f, rho, c));
             }
         }
-        let (f, rho, c) = best.unwrap_or((0.0, (sums.s * 0.5).sqrt(), sums.first));
+        let (f, rho, c) = best.unwrap_or((0.0, math::sqrt64(sums.s * 0.5), sums.first));
         Fit {
             centre: c,
             tangent: basis(c).0,
@@ -530,20 +539,20 @@ impl Fitter {
         sums: &Sums,
     ) -> (f64, f64) {
         let (t, bt) = basis(c);
-        let rho_min = (sums.w_min * 0.5).sqrt();
-        let rho_max = (2.0 * PI).sqrt();
-        let rho_s = (sums.s * 0.5).sqrt().clamp(rho_min, rho_max);
+        let rho_min = math::sqrt64(sums.w_min * 0.5);
+        let rho_max = math::sqrt64(2.0 * PI);
+        let rho_s = math::sqrt64(sums.s * 0.5).clamp(rho_min, rho_max);
         if sums.e <= 0.0 {
             return (Self::eval(rho_s, 0.0, 0.0, sums), rho_s);
         }
-        let rot: [(f64, f64); 4] = ROTATIONS.map(|r| (r.cos(), r.sin()));
+        let rot: [(f64, f64); 4] = ROTATIONS.map(|r| (math::cos64(r), math::sin64(r)));
         let nr = ROTATIONS.len() as f64;
         let ev = &mut self.events;
         ev.clear();
         for k in merged(a, b) {
             let k = k as usize;
             let q = lambert(td.dir[k], t, bt, c);
-            let h = 0.5 * td.w[k].sqrt();
+            let h = 0.5 * math::sqrt64(td.w[k]);
             let wl = td.lum[k] * td.w[k] / nr;
             let wc = td.w[k] / nr;
             let inv = 1.0 / (2.0 * SQRT_2 * h);
@@ -582,7 +591,7 @@ impl Fitter {
                 }
                 let disc = sc * sc + 8.0 * (cc - sc * rp);
                 if disc >= 0.0 {
-                    let rs = (sc + disc.sqrt()) * 0.25;
+                    let rs = (sc + math::sqrt64(disc)) * 0.25;
                     if rs > rp && rs < r {
                         consider(rs, g + sg * (rs - rp), cc + sc * (rs - rp));
                     }
@@ -603,15 +612,15 @@ impl Fitter {
     fn rotation(td: &Texels, texels: &[u32], fit: &mut Fit, sums: &Sums) {
         let (t, bt) = basis(fit.centre);
         let c = fit.centre;
-        let rho = (0.5 * fit.solid_angle).sqrt();
+        let rho = math::sqrt64(0.5 * fit.solid_angle);
         let mut best = (f64::INFINITY, 0usize);
         for (i, r) in ROTATIONS.iter().enumerate() {
-            let cs_sn = (r.cos(), r.sin());
+            let cs_sn = (math::cos64(*r), math::sin64(*r));
             let (mut g, mut cc) = (0.0, 0.0);
             for &k in texels {
                 let k = k as usize;
                 let dd = chebyshev(lambert(td.dir[k], t, bt, c), cs_sn);
-                let h = 0.5 * td.w[k].sqrt();
+                let h = 0.5 * math::sqrt64(td.w[k]);
                 let cov = ((rho / SQRT_2 - (dd - h)) / (2.0 * h)).clamp(0.0, 1.0);
                 g += cov * td.lum[k] * td.w[k];
                 cc += cov * td.w[k];
@@ -622,7 +631,7 @@ impl Fitter {
             }
         }
         fit.rotation = ROTATIONS[best.1];
-        let (cs, sn) = (fit.rotation.cos(), fit.rotation.sin());
+        let (cs, sn) = (math::cos64(fit.rotation), math::sin64(fit.rotation));
         fit.tangent = t * cs + bt * sn;
     }
 }
@@ -851,7 +860,7 @@ pub fn decompose_observed(
     let ks = check_ks(cube, &opts.ks, opts.cross_face)?;
     let mut st = State::new(cube, opts.cross_face, opts.objective);
     let k_min = *ks.last().unwrap_or(&1);
-    let total = (cube.len() - k_min) as u64;
+    obs.start((cube.len() - k_min) as u64);
     let mut heap = BinaryHeap::new();
     for a in 0..cube.len() as u32 {
         let ns: Vec<u32> = st.adj[a as usize]
@@ -884,7 +893,7 @@ pub fn decompose_observed(
         for nb in ns {
             heap.push(st.candidate(m, nb));
         }
-        obs.merged(total);
+        obs.merged();
         if st.n_alive == ks[next] {
             out.push(st.snapshot(ks[next], obs.seconds(), opts.cross_face));
             next += 1;

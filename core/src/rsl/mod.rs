@@ -22,7 +22,7 @@
 //!   `L(ω) = energy/Ω + G·(ω − c)` over the square that the moments kernel
 //!   ([`crate::rsl::shade::light_moments`]) evaluates. The paper's lights are uniform
 //!   (`G = 0`); the harness's decomposition sets `G` by matching the square's first moment
-//!   of radiance to the region's (`harness/src/env/decompose.rs`, "Radiance gradient").
+//!   of radiance to the region's ([`crate::rsl::decompose`], "Radiance gradient").
 //!
 //! ## Projection (paper Figure 3 and eq. 6)
 //!

@@ -52,10 +52,11 @@ impl Observer for Clock {
         self.start.elapsed().as_secs_f64()
     }
 
-    fn merged(&mut self, total: u64) {
-        if self.bar.length() != Some(total) {
-            self.bar.set_length(total);
-        }
+    fn start(&mut self, total: u64) {
+        self.bar.set_length(total);
+    }
+
+    fn merged(&mut self) {
         self.bar.inc(1);
         if !self.shown && self.want && self.start.elapsed().as_secs_f64() > 1.0 {
             self.bar.set_draw_target(ProgressDrawTarget::stderr());

@@ -27,14 +27,14 @@ impl Equirect {
     /// non-finite values; negative values (some EXR files have tiny ones) become 0.
     pub fn new(width: usize, height: usize, mut data: Vec<[f32; 3]>) -> Result<Equirect, EnvError> {
         if width == 0 || height == 0 || data.len() != width * height {
-            return Err(EnvError::Invalid(format!(
+            return Err(EnvError::invalid(format!(
                 "{} pixels for a {width} × {height} image",
                 data.len()
             )));
         }
         for (k, p) in data.iter_mut().enumerate() {
             if p.iter().any(|c| !c.is_finite()) {
-                return Err(EnvError::Invalid(format!(
+                return Err(EnvError::invalid(format!(
                     "pixel ({}, {}) is {p:?}: radiance must be finite",
                     k % width,
                     k / width
@@ -59,7 +59,7 @@ impl Equirect {
             .into_rgb32f();
         let (w, h) = (img.width() as usize, img.height() as usize);
         if w != 2 * h {
-            return Err(EnvError::Invalid(format!(
+            return Err(EnvError::invalid(format!(
                 "{}: {w} × {h} is not an equirectangular (2:1) image",
                 path.display()
             )));

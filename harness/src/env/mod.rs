@@ -30,20 +30,28 @@ pub fn real_env_path() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join(REAL_ENV)
 }
 
-/// What went wrong reading or building an environment.
+/// What went wrong reading or building an environment: the file, or the data (the
+/// error core's cube map and decomposition give).
 #[derive(Clone, Debug, PartialEq)]
 pub enum EnvError {
     /// The file could not be read or decoded.
     Io(String),
     /// The data was not a valid environment (size, non-finite values, …).
-    Invalid(String),
+    Invalid(steradian_core::rsl::cubemap::EnvError),
+}
+
+impl EnvError {
+    /// An invalid-environment error with this message.
+    pub fn invalid(msg: String) -> Self {
+        EnvError::Invalid(steradian_core::rsl::cubemap::EnvError::Invalid(msg))
+    }
 }
 
 impl fmt::Display for EnvError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
             EnvError::Io(s) => write!(f, "reading environment: {s}"),
-            EnvError::Invalid(s) => write!(f, "invalid environment: {s}"),
+            EnvError::Invalid(e) => e.fmt(f),
         }
     }
 }
@@ -52,9 +60,7 @@ impl std::error::Error for EnvError {}
 
 impl From<steradian_core::rsl::cubemap::EnvError> for EnvError {
     fn from(e: steradian_core::rsl::cubemap::EnvError) -> Self {
-        match e {
-            steradian_core::rsl::cubemap::EnvError::Invalid(s) => EnvError::Invalid(s),
-        }
+        EnvError::Invalid(e)
     }
 }
 
