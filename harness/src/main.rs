@@ -38,7 +38,7 @@ enum Command {
         no_gpu: bool,
     },
     /// Evaluate a kernel on JSON Lines from stdin, one JSON line out per line in.
-    #[command(after_help = eval_help())]
+    #[command(after_help = eval::help())]
     Eval {
         /// Kernel name (see below).
         kernel: String,
@@ -52,10 +52,6 @@ enum Command {
         #[arg(long)]
         dir: Option<PathBuf>,
     },
-}
-
-fn eval_help() -> String {
-    eval::help()
 }
 
 fn main() -> ExitCode {
@@ -92,7 +88,10 @@ fn main() -> ExitCode {
         }
         Command::Eval { kernel } => {
             if !eval::accepts(&kernel) {
-                eprintln!("steradian eval: unknown kernel {kernel:?}\n{}", eval_help());
+                eprintln!(
+                    "steradian eval: unknown kernel {kernel:?}\n{}",
+                    eval::help()
+                );
                 return ExitCode::from(2);
             }
             let stdin = std::io::stdin().lock();
