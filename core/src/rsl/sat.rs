@@ -475,16 +475,15 @@ impl<'a> SatView<'a> {
         let w = self.width;
         let w1 = w + 1;
         // Integer facts that let the compiler drop the per-entry bounds checks: every
-        // index below is then provably inside `r` (`i + 1 ≤ w < w1 = r.len()`).
-        let (i0, i1) = (i0.min(w.saturating_sub(1)), i1.min(w.saturating_sub(1)));
+        // index below is then provably inside `r` (`i + 1 ≤ w < w1 = r.len()`; `w ≥ 1`
+        // is an invariant of every constructor).
+        let (i0, i1) = (i0.min(w - 1), i1.min(w - 1));
         // Per row: [S(I0), S(I0+1), S(I1), S(I1+1)] (one range check per row; a row past
         // the table, which the callers never ask for, reads as zeros).
         let row = |l: usize| -> [i64; 4] {
             match row_range(l, w1).and_then(|range| self.sums.get(range)) {
-                Some(r) if r.len() > i1 + 1 && r.len() > i0 + 1 => {
-                    [r[i0], r[i0 + 1], r[i1], r[i1 + 1]]
-                }
-                _ => [0; 4],
+                Some(r) => [r[i0], r[i0 + 1], r[i1], r[i1 + 1]],
+                None => [0; 4],
             }
         };
         let (r0, r1) = (row(j0), row(j1));
