@@ -88,3 +88,23 @@ fn edge_fraction(t: f32, q: f32) -> f32 {
     let r = if tt >= 1.0 - q { hi_v } else { mid };
     if tt <= q - 1.0 { lo_v } else { r }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use core::f32::consts::SQRT_2;
+
+    #[test]
+    fn halfplane_fraction_limits() {
+        assert_eq!(square_halfplane_fraction(0.0, 0.3, -0.7), 0.5);
+        assert_eq!(square_halfplane_fraction(10.0, 1.0, 1.0), 1.0);
+        assert_eq!(square_halfplane_fraction(-10.0, 1.0, 1.0), 0.0);
+        assert_eq!(square_halfplane_fraction(0.5, 0.0, 0.0), 0.75);
+        // Diagonal: the corner triangle beyond distance t = 1/√2·(…): at t = 0 on the
+        // diagonal, ½; at the corner (t = −√2) 0.
+        assert_eq!(square_halfplane_fraction(-1.5, 1.0, 1.0), 0.0);
+        assert!(square_halfplane_fraction(-SQRT_2, 1.0, 1.0) < 1e-6);
+        assert!(square_halfplane_fraction(f32::NAN, 1.0, 0.0).is_nan());
+        assert_eq!(square_halfplane_fraction(f32::INFINITY, 1.0, 0.2), 1.0);
+    }
+}

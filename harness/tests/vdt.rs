@@ -10,8 +10,9 @@ use proptest::test_runner::Config;
 use crate::common::proptest_config;
 use steradian_core::Vec3;
 use steradian_core::frame::Frame;
+use steradian_core::grid::square_halfplane_fraction;
 use steradian_core::lobe::cap::SphericalCap;
-use steradian_core::rsl::vdt::{self, NO_BOUNDARY, Vdt, square_halfplane_fraction};
+use steradian_core::rsl::vdt::{self, NO_BOUNDARY, Vdt};
 use steradian_core::rsl::visibility::{self, Outside};
 use steradian_harness::rng::Rng;
 use steradian_harness::vdt::{

@@ -55,7 +55,7 @@
 //! - [`VdtView::gradient`], the straight-edge variant: the gradient of the bilinear `D`
 //!   (the analytic gradient within the cell) gives the edge normal `n`, and the visible
 //!   fraction is the **exact** area of the square on the side `n·(x − p) ≥ −D` of that
-//!   straight line ([`square_halfplane_fraction`]). Exact for every square cut by one
+//!   straight line ([`crate::grid::square_halfplane_fraction`]). Exact for every square cut by one
 //!   straight edge along texel boundaries (any axis-aligned edge); for other boundaries its
 //!   error is the rasterisation of the boundary (the staircase of the binary map, ≲ ½ texel)
 //!   and its curvature within the square. A zero gradient (a map without boundary, or a
@@ -69,7 +69,7 @@
 //! clamp to the edge of the table, and NaN in `u`, `v` or `r` gives NaN.
 
 use crate::Error;
-pub use crate::grid::{Q_MIN, square_halfplane_fraction};
+use crate::grid::square_halfplane_fraction;
 use crate::grid::{check_len, check_side, checked_product};
 use crate::math;
 use core::f32::consts::SQRT_2;
@@ -640,19 +640,5 @@ mod tests {
         // Infinite coordinates clamp to the edge.
         assert_eq!(v.query(f32::INFINITY, 0.5, 0.0), (0.0, 0.0));
         assert_eq!(v.query(f32::NEG_INFINITY, 0.5, 0.0), (1.0, 1.0));
-    }
-
-    #[test]
-    fn halfplane_fraction_limits() {
-        assert_eq!(square_halfplane_fraction(0.0, 0.3, -0.7), 0.5);
-        assert_eq!(square_halfplane_fraction(10.0, 1.0, 1.0), 1.0);
-        assert_eq!(square_halfplane_fraction(-10.0, 1.0, 1.0), 0.0);
-        assert_eq!(square_halfplane_fraction(0.5, 0.0, 0.0), 0.75);
-        // Diagonal: the corner triangle beyond distance t = 1/√2·(…): at t = 0 on the
-        // diagonal, ½; at the corner (t = −√2) 0.
-        assert_eq!(square_halfplane_fraction(-1.5, 1.0, 1.0), 0.0);
-        assert!(square_halfplane_fraction(-SQRT_2, 1.0, 1.0) < 1e-6);
-        assert!(square_halfplane_fraction(f32::NAN, 1.0, 0.0).is_nan());
-        assert_eq!(square_halfplane_fraction(f32::INFINITY, 1.0, 0.2), 1.0);
     }
 }

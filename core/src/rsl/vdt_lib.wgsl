@@ -5,7 +5,7 @@
 
 // sqrt(2) rounded to f32, as `core::f32::consts::SQRT_2`.
 const SQRT_2: f32 = 1.4142135623730951;
-// `vdt::R_MIN`, `vdt::R_MAX`, `vdt::Q_MIN`.
+// `vdt::R_MIN`, `vdt::R_MAX`, `grid::Q_MIN`.
 const R_MIN: f32 = 1e-12;
 const R_MAX: f32 = 1.2089258196146292e24;
 const Q_MIN: f32 = 1e-20;

@@ -25,7 +25,7 @@
 //! or nothing; a crossed one is split in four, down to [`LEAF_DEPTH`] levels (leaves of
 //! `1/32` texel side). At a leaf crossed by one boundary the boundary is replaced by its
 //! tangent line (from the value and a central-difference gradient) and the leaf's fraction on
-//! the visible side is the exact straight-edge area ([`crate::rsl::vdt::square_halfplane_fraction`]);
+//! the visible side is the exact straight-edge area ([`crate::grid::square_halfplane_fraction`]);
 //! a leaf crossed by two or more boundaries (where caps overlap or meet the horizon) is
 //! point-sampled 4 × 4. The error per texel is of the order of the boundary's curvature times
 //! the cube of the leaf size; the harness tests the total visible solid angle of one sphere

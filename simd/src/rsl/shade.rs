@@ -25,9 +25,10 @@
 
 use glam::Vec3;
 use steradian_core::frame::Frame;
+use steradian_core::grid::Q_MIN;
 use steradian_core::rsl::sat::SatView;
 use steradian_core::rsl::shade::{ShadeLight, VdtQuery};
-use steradian_core::rsl::vdt::{Q_MIN, R_MAX, R_MIN, VdtView};
+use steradian_core::rsl::vdt::{R_MAX, R_MIN, VdtView};
 use steradian_core::rsl::vis_moments::{AxisKnots, VisMomentsView, axis_knots};
 use wide::{f32x8, f64x8, i64x8};
 
@@ -193,7 +194,7 @@ fn box_pair_f64(
     (one(&g[0], quanta[0]), one(&g[1], quanta[1]))
 }
 
-/// The straight-edge fraction (`steradian_core::rsl::vdt::square_halfplane_fraction` after the
+/// The straight-edge fraction (`steradian_core::grid::square_halfplane_fraction` after the
 /// reduction of the normal to `q`), lane-wise.
 #[inline(always)]
 fn edge_fraction(t: f32x8, q: f32x8) -> f32x8 {

@@ -10,7 +10,8 @@
 //! scalar query of that lane, for every input (NaN-ness matches). `wide` has no gather: the
 //! four samples of each lane are read by scalar indexing from the lanes' cell indices.
 
-use steradian_core::rsl::vdt::{Q_MIN, R_MAX, R_MIN, VdtView};
+use steradian_core::grid::Q_MIN;
+use steradian_core::rsl::vdt::{R_MAX, R_MIN, VdtView};
 use wide::f32x8;
 
 use crate::lanes::{ColumnKernel, Lanes, SliceVec, clamp, drive, max_num, min_num};
