@@ -132,7 +132,7 @@ pub const KERNELS: &[KernelSpec] = &[
             tolerance: "steradian_core::wgsl::HEMISPHERE_MAP_ABS_TOL",
             table: None,
         }),
-        reference: Piece::At("steradian_harness::reference::hemisphere_map"),
+        reference: Piece::At("steradian_reference::rsl::hemisphere_map"),
         bound: Piece::At(Bound {
             metric: "abs",
             item: "steradian_core::rsl::hemisphere::MAP_ABS_ERROR",
@@ -153,7 +153,7 @@ pub const KERNELS: &[KernelSpec] = &[
             tolerance: "steradian_core::wgsl::HEMISPHERE_UNMAP_ABS_TOL",
             table: None,
         }),
-        reference: Piece::At("steradian_harness::reference::hemisphere_unmap"),
+        reference: Piece::At("steradian_reference::rsl::hemisphere_unmap"),
         bound: Piece::At(Bound {
             metric: "abs",
             item: "steradian_core::rsl::hemisphere::UNMAP_ABS_ERROR",
@@ -174,7 +174,7 @@ pub const KERNELS: &[KernelSpec] = &[
             tolerance: "steradian_core::wgsl::LOBE_EVAL_REL_TOL",
             table: None,
         }),
-        reference: Piece::At("steradian_harness::reference::lobe_eval"),
+        reference: Piece::At("steradian_reference::lobe::lobe_eval"),
         bound: Piece::At(Bound {
             metric: "rel/κ",
             item: "steradian_core::lobe::EVAL_REL_ERROR",
@@ -195,7 +195,7 @@ pub const KERNELS: &[KernelSpec] = &[
             tolerance: "steradian_core::wgsl::LOBE_INTEGRAL_ULP_TOL",
             table: None,
         }),
-        reference: Piece::At("steradian_harness::reference::lobe_integral"),
+        reference: Piece::At("steradian_reference::lobe::lobe_integral"),
         bound: Piece::At(Bound {
             metric: "rel",
             item: "steradian_core::lobe::INTEGRAL_REL_ERROR",
@@ -216,7 +216,7 @@ pub const KERNELS: &[KernelSpec] = &[
             tolerance: "steradian_core::wgsl::CAP_EXPONENT_REL_TOL",
             table: None,
         }),
-        reference: Piece::At("steradian_harness::reference::cap::optimal_exponent"),
+        reference: Piece::At("steradian_reference::lobe::cap::optimal_exponent"),
         bound: Piece::At(Bound {
             metric: "excess-L2-rel",
             item: "steradian_core::lobe::cap::EXCESS_L2_REL",
@@ -237,7 +237,7 @@ pub const KERNELS: &[KernelSpec] = &[
             tolerance: "steradian_core::wgsl::LOBE_PRODUCT_TOL",
             table: Some("f32"),
         }),
-        reference: Piece::At("steradian_harness::reference::product::product_integral"),
+        reference: Piece::At("steradian_reference::lobe::product::product_integral"),
         bound: Piece::At(Bound {
             metric: "integral-rel-max",
             item: "steradian_core::lobe::product::INTEGRAL_REL_MAX",
@@ -279,7 +279,7 @@ pub const KERNELS: &[KernelSpec] = &[
             tolerance: "steradian_core::wgsl::VDT_QUERY_TOL",
             table: Some("f32"),
         }),
-        reference: Piece::At("steradian_harness::vdt::brute_force_squares"),
+        reference: Piece::At("steradian_reference::rsl::vdt::brute_force_squares"),
         bound: Piece::At(Bound {
             metric: "visible-fraction-abs",
             item: "steradian_core::rsl::vdt::VdtView::query",
@@ -470,6 +470,7 @@ fn item_exists(root: &std::path::Path, path: &str) -> Result<(), String> {
         "steradian_core" => "core/src",
         "steradian_simd" => "simd/src",
         "steradian_harness" => "harness/src",
+        "steradian_reference" => "reference/src",
         other => return Err(format!("unknown crate {other}")),
     };
     // The longest module prefix with a source file; the rest is `item` or `Type::item`.

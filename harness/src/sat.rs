@@ -5,6 +5,7 @@
 use serde_json::{Map, Value, json};
 use steradian_core::rsl::sat::{Sat, SatView};
 use steradian_core::wgsl;
+use steradian_reference::rsl::sat::box_integral;
 
 use crate::backend::BackendError;
 use crate::backend::gpu::{Custom, Gpu};
@@ -21,32 +22,6 @@ pub struct Grid {
     pub height: usize,
     /// `width·height` texels.
     pub texels: Vec<f32>,
-}
-
-/// The interval between `c0` and `c1`, ordered and clipped to `[0, n]`, in f64.
-fn clipped(c0: f32, c1: f32, n: usize) -> (f64, f64) {
-    let (c0, c1) = (c0 as f64, c1 as f64);
-    (
-        c0.min(c1).clamp(0.0, n as f64),
-        c0.max(c1).clamp(0.0, n as f64),
-    )
-}
-
-/// Overlap of `[lo, hi]` (ordered, clipped to `[0, n]`) with `[i, i+1]`, in f64.
-fn overlap(c0: f32, c1: f32, n: usize, i: usize) -> f64 {
-    let (lo, hi) = clipped(c0, c1, n);
-    (hi.min(i as f64 + 1.0) - lo.max(i as f64)).max(0.0)
-}
-
-/// The column (or row) range `[first, last]` of texels with a positive overlap, if any.
-fn span(c0: f32, c1: f32, n: usize) -> Option<(usize, usize)> {
-    let (lo, hi) = clipped(c0, c1, n);
-    if hi <= lo {
-        return None;
-    }
-    let first = lo.floor() as usize;
-    let last = ((hi.ceil() as usize).max(1) - 1).min(n - 1);
-    Some((first.min(n - 1), last))
 }
 
 /// Reference values of one box.
@@ -87,7 +62,8 @@ impl Grid {
         self.texels.iter().map(|t| (*t as f64).abs()).sum()
     }
 
-    /// The exact box integral (f64 brute force) and the `A`, `n` of the bound.
+    /// The exact box integral (the f64 brute force of `steradian-reference`) and the `A`,
+    /// `n` of the bound.
     /// NaN corners give a NaN value.
     pub fn reference(&self, u0: f32, v0: f32, u1: f32, v1: f32) -> BoxRef {
         if [u0, v0, u1, v1].iter().any(|c| c.is_nan()) {
@@ -97,19 +73,7 @@ impl Grid {
                 n_read: 0,
             };
         }
-        let mut value = 0.0;
-        if let (Some((i0, i1)), Some((j0, j1))) =
-            (span(u0, u1, self.width), span(v0, v1, self.height))
-        {
-            for j in j0..=j1 {
-                let wy = overlap(v0, v1, self.height, j);
-                let mut row = 0.0;
-                for i in i0..=i1 {
-                    row += self.at(i, j) as f64 * overlap(u0, u1, self.width, i);
-                }
-                value += row * wy;
-            }
-        }
+        let value = box_integral(self.width, self.height, &self.texels, u0, v0, u1, v1);
         // The texels the core kernel reads: its (I0, I1) × (J0, J1).
         let (i0, _, i1, _) = steradian_core::rsl::sat::axis(u0, u1, self.width);
         let (j0, _, j1, _) = steradian_core::rsl::sat::axis(v0, v1, self.height);

@@ -8,16 +8,14 @@ use std::f64::consts::{FRAC_PI_2, TAU};
 use steradian_core::lobe::brdf::{BlinnPhong, Brdf, Ggx, Lambert, Phong, Ward};
 use steradian_core::rsl::brdf_sat::{BrdfSat, FitOptions, Resolution};
 use steradian_core::{Vec2, Vec3};
+use steradian_harness::reference::AsModel;
 use steradian_harness::reference::brdf::{self as rb, Model};
 use steradian_harness::rng::Rng;
 
 type Pair = (Box<dyn Brdf>, Model);
 
-fn pair<B: Brdf + Copy + 'static>(b: B) -> Pair
-where
-    Model: From<B>,
-{
-    (Box::new(b), Model::from(b))
+fn pair<B: Brdf + Copy + AsModel + 'static>(b: B) -> Pair {
+    (Box::new(b), b.model())
 }
 
 /// Every model, with the hard parameters of the issue.
@@ -97,7 +95,7 @@ fn eval_matches_f64_formulas() {
             if want < 1e-6 * peak {
                 continue;
             }
-            let got = rb::core_eval(b.as_ref(), wi, wo) as f64;
+            let got = steradian_harness::reference::core_eval(b.as_ref(), wi, wo) as f64;
             worst = worst.max((got - want).abs() / want);
         }
         // Sharp lobes amplify the rounding of the f32 inputs: `e·Δ(cos)` with Δ ≈ 1e-7.
@@ -161,7 +159,7 @@ fn reciprocity_ggx() {
 
 #[test]
 fn lambert_albedo_is_the_albedo() {
-    let m = Model::from(Lambert::new(0.8).unwrap());
+    let m = Lambert::new(0.8).unwrap().model();
     for theta in [0.0, 1.0, 1.5] {
         let a = rb::albedo(&m, dir(theta, 0.3), 1e-10);
         assert!((a - 0.8).abs() < 1e-7, "{a}");
@@ -172,7 +170,7 @@ fn lambert_albedo_is_the_albedo() {
 fn normal_incidence_phong_albedo_is_kd_plus_ks() {
     // ∫ (e+2)/(2π) cos^(e+1) dω = 1 at normal incidence, for any e (sharp lobes included).
     for e in [0.0, 1.0, 20.0, 1000.0, 1e4] {
-        let m = Model::from(Phong::new(0.25, 0.7, e as f32).unwrap());
+        let m = Phong::new(0.25, 0.7, e as f32).unwrap().model();
         let a = rb::albedo(&m, [0.0, 0.0, 1.0], 1e-10);
         assert!((a - 0.95).abs() < 1e-6, "e = {e}: {a}");
     }
@@ -217,7 +215,7 @@ fn energy_at_most_one() {
 fn albedo_claims_blinn_phong_bound_and_ward_at_89_degrees() {
     let bp = steradian_core::lobe::brdf::BLINN_PHONG_ALBEDO_BOUND as f64;
     for e in [0.0, 1.0, 3.0, 10.0, 30.0, 100.0, 1000.0] {
-        let m = Model::from(BlinnPhong::new(0.0, 1.0, e as f32).unwrap());
+        let m = BlinnPhong::new(0.0, 1.0, e as f32).unwrap().model();
         let w = (0..=30)
             .map(|k| rb::albedo(&m, dir((89.0 * k as f64 / 30.0).to_radians(), 0.0), 1e-7))
             .fold(0.0f64, f64::max);
@@ -225,7 +223,7 @@ fn albedo_claims_blinn_phong_bound_and_ward_at_89_degrees() {
         assert!(w <= bp, "Blinn-Phong e = {e}: {w}");
     }
     for a in [0.05, 0.1, 0.2, 0.3, 0.5, 1.0] {
-        let m = Model::from(Ward::isotropic(0.0, 1.0, a as f32).unwrap());
+        let m = Ward::isotropic(0.0, 1.0, a as f32).unwrap().model();
         let w: Vec<_> = [0.0, 60.0, 70.0, 80.0, 85.0, 89.0]
             .iter()
             .map(|t: &f64| rb::albedo(&m, dir(t.to_radians(), 0.0), 1e-7))
@@ -327,31 +325,31 @@ fn modest(target: f32) -> FitOptions {
 #[test]
 fn brdf_sat_lambert_within_reported_error() {
     let b = Lambert::new(0.8).unwrap();
-    check_met(&b, &b.into(), &modest(1e-3));
+    check_met(&b, &b.model(), &modest(1e-3));
 }
 
 #[test]
 fn brdf_sat_phong_within_reported_error() {
     let b = Phong::new(0.3, 0.6, 50.0).unwrap();
-    check_met(&b, &b.into(), &modest(0.03));
+    check_met(&b, &b.model(), &modest(0.03));
 }
 
 #[test]
 fn brdf_sat_blinn_phong_within_reported_error() {
     let b = BlinnPhong::new(0.3, 0.6, 100.0).unwrap();
-    check_met(&b, &b.into(), &modest(0.02));
+    check_met(&b, &b.model(), &modest(0.02));
 }
 
 #[test]
 fn brdf_sat_ward_within_reported_error() {
     let b = Ward::isotropic(0.3, 0.2, 0.2).unwrap();
-    check_met(&b, &b.into(), &modest(0.02));
+    check_met(&b, &b.model(), &modest(0.02));
 }
 
 #[test]
 fn brdf_sat_ggx_within_reported_error() {
     let b = Ggx::new(0.3, 0.04, 0.3).unwrap();
-    check_met(&b, &b.into(), &modest(0.02));
+    check_met(&b, &b.model(), &modest(0.02));
 }
 
 #[test]
@@ -366,7 +364,7 @@ fn brdf_sat_ward_anisotropic_within_reported_error() {
         max_bytes: 32 << 20,
         ..modest(0.1)
     };
-    check_met(&b, &b.into(), &opts);
+    check_met(&b, &b.model(), &opts);
 }
 
 /// Sharp lobes need a finer grid than diffuse ones ("model only what a scene needs").
@@ -398,7 +396,7 @@ fn sharp_phong_e_1e4_needs_a_finer_grid_than_diffuse() {
 fn ggx_roughness_0_01_and_1() {
     for alpha in [0.01f32, 1.0] {
         let b = Ggx::new(0.2, 0.5, alpha).unwrap();
-        let m = Model::from(b);
+        let m = b.model();
         let opts = FitOptions {
             r_min: 0.15,
             ..modest(0.05)
@@ -410,7 +408,7 @@ fn ggx_roughness_0_01_and_1() {
 #[test]
 fn normal_incidence_any_square() {
     let b = Phong::new(0.3, 0.6, 50.0).unwrap();
-    let m = Model::from(b);
+    let m = b.model();
     let t = BrdfSat::build(&b, res(128, 9, 1), 80f32.to_radians()).unwrap();
     let albedo = rb::albedo(&m, [0.0, 0.0, 1.0], 1e-9);
     assert!((albedo - 0.9).abs() < 1e-6);
@@ -427,7 +425,7 @@ fn normal_incidence_any_square() {
 #[test]
 fn grazing_view_89_degrees() {
     let b = Ggx::new(0.2, 0.5, 0.3).unwrap();
-    let m = Model::from(b);
+    let m = b.model();
     let opts = FitOptions {
         r_min: 0.15,
         theta_max: 89f32.to_radians(),

@@ -20,7 +20,8 @@ use steradian_core::lobe::sum::{
     phong_reflectance, triple,
 };
 use steradian_core::lobe::{CosineLobe, Lafortune, LafortuneLobe, Phong};
-use steradian_harness::reference::triple::{self as reference, Cap, Lobe, Scene, Term, Visibility};
+use steradian_harness::reference as adapt;
+use steradian_harness::reference::triple::{self as reference, Scene, Term, Visibility};
 use steradian_harness::rng::Rng;
 
 /// Bound on `|chain(t = 0) − lobe-model reference| / S` with the cosine on the light
@@ -102,9 +103,9 @@ impl Config {
         let n = v3(self.normal);
         let exact = |l: &CosineLobe, times_cos: bool| {
             if times_cos {
-                Term::LobeTimesCosine(Lobe::from_core(l), n)
+                Term::LobeTimesCosine(adapt::lobe_of(l), n)
             } else {
-                Term::Lobe(Lobe::from_core(l))
+                Term::Lobe(adapt::lobe_of(l))
             }
         };
         let with_cos = self.cosine != Cosine::AsGiven;
@@ -127,8 +128,8 @@ impl Config {
     fn lobe_model(&self, b: &Built) -> Scene {
         Scene {
             reflectance: self.reflectance_terms(),
-            light: reference::terms_of(&b.l_raw),
-            visibility: Visibility::Lobes(reference::terms_of(&b.v)),
+            light: adapt::terms_of(&b.l_raw),
+            visibility: Visibility::Lobes(adapt::terms_of(&b.v)),
         }
     }
 
@@ -139,12 +140,12 @@ impl Config {
             light: self
                 .lights
                 .iter()
-                .map(|(c, rad)| Term::Cap(Cap::from_core(c), *rad as f64))
+                .map(|(c, rad)| Term::Cap(adapt::cap_of(c), *rad as f64))
                 .collect(),
             visibility: Visibility::Occluders(
                 self.occluders
                     .iter()
-                    .map(|(c, _)| Cap::from_core(c))
+                    .map(|(c, _)| adapt::cap_of(c))
                     .collect(),
             ),
         }

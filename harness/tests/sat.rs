@@ -1,8 +1,9 @@
 //! Summed-area tables: `steradian_core::rsl::sat` against the f64 brute-force sum (property tests
 //! with a fixed seed, the stated bound `2⁻²⁴·|I| + 2⁻¹⁵⁰ + 2⁻⁴⁶·A + n·2⁻⁵⁹·T`), named hard cases,
-//! the SIMD kernel lane by lane (bit-exact), the WGSL kernel on a real adapter (within
+//! the WGSL kernel on a real adapter (within
 //! `wgsl::SAT_BOX_REL_TOL`; naga validation is in `wgsl_validate.rs`), and
-//! `steradian eval sat-box`.
+//! `steradian eval sat-box`. The SIMD kernel is checked lane by lane, bit for bit, in
+//! `steradian-simd`'s `rsl` tests.
 
 use proptest::prelude::*;
 use proptest::test_runner::Config;
@@ -382,67 +383,15 @@ fn build_into_and_view_match_the_owned_table() {
     assert!(SatView::build_into(33, 33, &g.texels, &mut short).is_err());
 }
 
-// ---- SIMD: lane by lane, bit-exact ------------------------------------------------------
+// ---- Integer fast paths ------------------------------------------------------------------
 
 fn same(a: f32, b: f32) -> bool {
     a.to_bits() == b.to_bits() || (a.is_nan() && b.is_nan())
 }
 
-/// `steradian_simd::rsl::sat::box_sum_slices` over the boxes `qs`.
-fn simd_box_sums(v: &SatView<'_>, qs: &[[f32; 4]]) -> Vec<f32> {
-    let cols = Columns::from_rows(qs);
-    let mut out = vec![0.0; qs.len()];
-    steradian_simd::rsl::sat::box_sum_slices(
-        v,
-        cols.col(0),
-        cols.col(1),
-        cols.col(2),
-        cols.col(3),
-        &mut out,
-    );
-    out
-}
-
-#[test]
-fn simd_matches_scalar_bit_for_bit() {
-    let mut rng = Rng::new(77);
-    for (w, h) in [(1, 1), (1, 9), (9, 1), (17, 13), (64, 64), (300, 7)] {
-        let g = random_grid(w, h, &mut rng);
-        let s = build(&g);
-        let v = s.view();
-        let specials = [f32::NAN, f32::INFINITY, -f32::INFINITY, -0.0, 0.0, 1e-45];
-        for len in [0usize, 1, 7, 8, 9, 100, 1001] {
-            let mut c = |n: usize| -> f32 {
-                if rng.unit() < 0.05 {
-                    specials[(rng.next_u64() % specials.len() as u64) as usize]
-                } else {
-                    rng.range(-2.0, n as f64 + 2.0) as f32
-                }
-            };
-            let qs: Vec<[f32; 4]> = (0..len).map(|_| [c(w), c(h), c(w), c(h)]).collect();
-            let cols = Columns::from_rows(&qs);
-            let mut out = simd_box_sums(&v, &qs);
-            for (k, q) in qs.iter().enumerate() {
-                let want = v.box_sum(q[0], q[1], q[2], q[3]);
-                assert!(
-                    same(out[k], want),
-                    "{w}×{h} lane {k} {q:?}: {} vs {want}",
-                    out[k]
-                );
-            }
-            let rs: Vec<f32> = qs.iter().map(|q| q[2] - q[0]).collect();
-            steradian_simd::rsl::sat::square_slices(&v, cols.col(0), cols.col(1), &rs, &mut out);
-            for (k, q) in qs.iter().enumerate() {
-                let want = v.square(Vec2::new(q[0], q[1]), rs[k]);
-                assert!(same(out[k], want), "square {w}×{h} lane {k}");
-            }
-        }
-    }
-}
-
-/// Integer corners (the fast paths: the scalar four-lookup path, `box_sum_cells`, and the
-/// SIMD kernel's all-lanes-integer path): inside, on the far edges, outside, inverted, and
-/// mixed with NaN lanes and fractional lanes. `box_sum_cells` gives `box_sum`'s bits while
+/// Integer corners (the fast paths: the scalar four-lookup path and `box_sum_cells`; the
+/// SIMD kernel's all-lanes-integer path is in `steradian-simd`'s `rsl` tests): inside, on
+/// the far edges, outside, inverted. `box_sum_cells` gives `box_sum`'s bits while
 /// both corners lie before the last column and row; at and past the far edges it reads the
 /// exact integer box (where `box_sum` takes its general path), so there it is held to its
 /// own bound against the brute force, and to the same bits as its ordered, clipped box.
@@ -492,36 +441,13 @@ fn integer_corner_fast_paths_match_the_general_query_bit_for_bit() {
             }
             check(&g, &s, t, f).unwrap();
         }
-        // Batches of 8 all-integer lanes (the SIMD integer path), then batches where one
-        // lane is NaN or fractional (the general path) — every lane as the scalar query.
-        for spoil in [None, Some(f32::NAN), Some(0.5f32)] {
-            let fq: Vec<[f32; 4]> = qs
-                .iter()
-                .enumerate()
-                .map(|(k, q)| {
-                    let mut f = q.map(|x| x as f32);
-                    if let Some(x) = spoil.filter(|_| k % 8 == 3) {
-                        f[1] = if x.is_nan() { x } else { f[1] + x };
-                    }
-                    f
-                })
-                .collect();
-            let out = simd_box_sums(&v, &fq);
-            for (k, f) in fq.iter().enumerate() {
-                let want = v.box_sum(f[0], f[1], f[2], f[3]);
-                assert!(
-                    same(out[k], want),
-                    "{w}×{h} SIMD lane {k} {f:?}: {} vs {want}",
-                    out[k]
-                );
-            }
-        }
     }
 }
 
 /// Integer texels with integer corners: the fixed-point sum is exact, so the query is the
 /// correctly rounded exact sum (what the f32 tables of the other crates miss, bench
-/// `sat`), through the scalar, the integer-coordinate and the SIMD query.
+/// `sat`), through the scalar and the integer-coordinate query (the SIMD query equals the
+/// scalar one bit for bit: `steradian-simd`'s `rsl` tests).
 #[test]
 fn integer_boxes_of_integer_texels_are_correctly_rounded() {
     let n = 512;
@@ -550,14 +476,11 @@ fn integer_boxes_of_integer_texels_are_correctly_rounded() {
             [x0, y0, x1, y1]
         })
         .collect();
-    let fq: Vec<[f32; 4]> = qs.iter().map(|q| q.map(|x| x as f32)).collect();
-    let out = simd_box_sums(&v, &fq);
-    for (k, q) in qs.iter().enumerate() {
+    for q in &qs {
         let want = exact(q[0], q[1], q[2], q[3]);
         let f = q.map(|x| x as f32);
         assert_eq!(v.box_sum(f[0], f[1], f[2], f[3]), want, "{q:?}");
         assert_eq!(v.box_sum_cells(q[0], q[1], q[2], q[3]), want, "{q:?}");
-        assert_eq!(out[k], want, "SIMD {q:?}");
     }
 }
 

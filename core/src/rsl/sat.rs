@@ -749,21 +749,7 @@ mod tests {
     use super::*;
     use alloc::vec::Vec;
 
-    /// f64 brute force: Σ t(i,j)·overlap_x(i)·overlap_y(j).
-    fn brute(w: usize, h: usize, t: &[f32], u0: f32, v0: f32, u1: f32, v1: f32) -> f64 {
-        let ov = |lo: f32, hi: f32, n: usize, i: usize| -> f64 {
-            let (lo, hi) = (lo.min(hi) as f64, lo.max(hi) as f64);
-            let (lo, hi) = (lo.clamp(0.0, n as f64), hi.clamp(0.0, n as f64));
-            (hi.min(i as f64 + 1.0) - lo.max(i as f64)).max(0.0)
-        };
-        let mut s = 0.0;
-        for j in 0..h {
-            for i in 0..w {
-                s += t[j * w + i] as f64 * ov(u0, u1, w, i) * ov(v0, v1, h, j);
-            }
-        }
-        s
-    }
+    use steradian_reference::rsl::sat::box_integral as brute;
 
     #[test]
     fn small_table_matches_brute_force() {

@@ -332,37 +332,9 @@ pub fn axis_knots(lo: f64, hi: f64, n: usize) -> AxisKnots {
 mod tests {
     use super::*;
 
-    /// Texel by texel: the exact overlap of each texel with the square and its moment at
-    /// the overlap's centroid (the piecewise-constant map; outside the table visible), in
-    /// f64.
+    /// The f64 brute force of `steradian-reference`, at a `Vec2` centre.
     fn brute(n: usize, cov: &[f32], c: Vec2, r: f32) -> (f64, f64, f64) {
-        let hn = 0.5 * n as f64;
-        let h = f64::from(r) * core::f64::consts::FRAC_1_SQRT_2 * hn;
-        let (cu, cv) = ((f64::from(c.x) + 1.0) * hn, (f64::from(c.y) + 1.0) * hn);
-        let (mut s, mut mx, mut my) = (0.0, 0.0, 0.0);
-        let lo = |x: f64| x.floor() as i64;
-        for j in lo(cv - h)..=lo(cv + h) {
-            for i in lo(cu - h)..=lo(cu + h) {
-                let (x0, x1) = ((i as f64).max(cu - h), ((i + 1) as f64).min(cu + h));
-                let (y0, y1) = ((j as f64).max(cv - h), ((j + 1) as f64).min(cv + h));
-                if x1 <= x0 || y1 <= y0 {
-                    continue;
-                }
-                let a = (x1 - x0) * (y1 - y0);
-                let inside = i >= 0 && j >= 0 && (i as usize) < n && (j as usize) < n;
-                let vis = if inside {
-                    f64::from(cov[j as usize * n + i as usize])
-                } else {
-                    1.0
-                };
-                let (px, py) = (0.5 * (x0 + x1), 0.5 * (y0 + y1));
-                s += a * vis;
-                mx += a * vis * (px - cu);
-                my += a * vis * (py - cv);
-            }
-        }
-        let area = 4.0 * h * h;
-        (s / area, mx / (area * hn), my / (area * hn))
+        steradian_reference::rsl::moments::square_moments(n, cov, c.to_array(), r)
     }
 
     #[test]

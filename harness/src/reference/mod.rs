@@ -1,75 +1,104 @@
-//! Exact f64 references for every kernel: closed forms where they exist, a bracketed
-//! root solve for the cap-exponent optimum. Float functions come from the pure-Rust `libm`
-//! crate so results (and the generated tables) are the same on every machine.
+//! The f64 references of the `steradian-reference` crate under their harness paths, and the
+//! adapters from core's `f32` types to the references' `f64` ones (kept here so that the
+//! reference crate does not depend on the code it checks).
 
-pub mod brdf;
-pub mod cap;
-pub mod product;
-pub mod quad;
-pub mod triple;
+pub use steradian_reference::lobe::{
+    brdf, cap, cap_solid_angle, lobe_eval, lobe_integral, normalize, product, triple,
+};
+pub use steradian_reference::quad;
+pub use steradian_reference::rsl::{hemisphere_map, hemisphere_unmap};
 
-use std::f64::consts::{PI, TAU};
+use steradian_core::lobe::CosineLobe;
+use steradian_core::lobe::brdf as core_brdf;
+use steradian_core::lobe::cap::SphericalCap;
+use steradian_core::lobe::sum::LobeTerms;
 
-/// `v` normalised in f64 after scaling by its largest component (no overflow).
-pub fn normalize(v: [f32; 3]) -> Option<[f64; 3]> {
-    let v = v.map(f64::from);
-    let m = v[0].abs().max(v[1].abs()).max(v[2].abs());
-    if !(m > 0.0 && m.is_finite()) {
-        return None;
-    }
-    let s = v.map(|c| c / m);
-    let l = libm::sqrt(s[0] * s[0] + s[1] * s[1] + s[2] * s[2]);
-    Some(s.map(|c| c / l))
+/// The f32 lobe, widened (axis renormalised in f64).
+pub fn lobe_of(l: &CosineLobe) -> triple::Lobe {
+    let a = l.axis();
+    triple::Lobe::new(
+        [a.x as f64, a.y as f64, a.z as f64],
+        l.scale() as f64,
+        l.exponent() as f64,
+    )
 }
 
-/// Exact equal-area map of the normalised direction (lower hemisphere mirrored; zero → pole).
-pub fn hemisphere_map(dir: [f32; 3]) -> [f64; 2] {
-    match normalize(dir) {
-        None if dir == [0.0; 3] => [0.0, 0.0],
-        None => [f64::NAN; 2],
-        Some([x, y, z]) => {
-            let s = 1.0 / libm::sqrt(1.0 + z.abs());
-            [x * s, y * s]
+/// The f32 cap, widened.
+pub fn cap_of(c: &SphericalCap) -> triple::Cap {
+    let a = c.axis();
+    triple::Cap::new([a.x as f64, a.y as f64, a.z as f64], c.half_angle() as f64)
+}
+
+/// The terms of a core lobe sum (`k + Σ lobes`).
+pub fn terms_of(s: &impl LobeTerms) -> Vec<triple::Term> {
+    let mut t: Vec<triple::Term> = s
+        .lobes()
+        .iter()
+        .map(|l| triple::Term::Lobe(lobe_of(l)))
+        .collect();
+    if s.constant() != 0.0 {
+        t.insert(0, triple::Term::Constant(s.constant() as f64));
+    }
+    t
+}
+
+/// A core BRDF model's parameters, widened to the reference [`brdf::Model`].
+pub trait AsModel {
+    /// The reference model with the same parameters.
+    fn model(&self) -> brdf::Model;
+}
+
+impl AsModel for core_brdf::Lambert {
+    fn model(&self) -> brdf::Model {
+        brdf::Model::Lambert {
+            a: self.albedo() as f64,
+        }
+    }
+}
+impl AsModel for core_brdf::Phong {
+    fn model(&self) -> brdf::Model {
+        let (kd, ks, e) = self.params();
+        brdf::Model::Phong {
+            kd: kd as f64,
+            ks: ks as f64,
+            e: e as f64,
+        }
+    }
+}
+impl AsModel for core_brdf::BlinnPhong {
+    fn model(&self) -> brdf::Model {
+        let (kd, ks, e) = self.params();
+        brdf::Model::BlinnPhong {
+            kd: kd as f64,
+            ks: ks as f64,
+            e: e as f64,
+        }
+    }
+}
+impl AsModel for core_brdf::Ward {
+    fn model(&self) -> brdf::Model {
+        let (rd, rs, ax, ay) = self.params();
+        brdf::Model::Ward {
+            rd: rd as f64,
+            rs: rs as f64,
+            ax: ax as f64,
+            ay: ay as f64,
+        }
+    }
+}
+impl AsModel for core_brdf::Ggx {
+    fn model(&self) -> brdf::Model {
+        let (kd, f0, alpha) = self.params();
+        brdf::Model::Ggx {
+            kd: kd as f64,
+            f0: f0 as f64,
+            alpha: alpha as f64,
         }
     }
 }
 
-/// Exact inverse map (points outside the disk clamped radially onto the circle).
-pub fn hemisphere_unmap(p: [f32; 2]) -> [f64; 3] {
-    let (mut u, mut v) = (p[0] as f64, p[1] as f64);
-    let mut r2 = u * u + v * v;
-    if r2 > 1.0 {
-        let k = 1.0 / libm::sqrt(r2);
-        u *= k;
-        v *= k;
-        r2 = 1.0;
-    }
-    let s = libm::sqrt(2.0 - r2);
-    [u * s, v * s, 1.0 - r2]
-}
-
-/// `s·max(â·v̂, 0)^e` with axis and direction normalised in f64 and `1 − â·v̂` computed as
-/// `|â − v̂|²/2` (no cancellation near the axis).
-pub fn lobe_eval(axis: [f32; 3], scale: f32, exponent: f32, v: [f32; 3]) -> f64 {
-    let (Some(a), Some(v)) = (normalize(axis), normalize(v)) else {
-        return f64::NAN;
-    };
-    let e = (exponent as f64).max(0.0);
-    let d = [a[0] - v[0], a[1] - v[1], a[2] - v[2]];
-    let t = 0.5 * (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
-    if t >= 1.0 {
-        return 0.0;
-    }
-    scale as f64 * libm::exp(e * libm::log1p(-t))
-}
-
-/// `2π·s/(e + 1)`.
-pub fn lobe_integral(exponent: f32, scale: f32) -> f64 {
-    TAU * scale as f64 / ((exponent as f64).max(0.0) + 1.0)
-}
-
-/// Solid angle of a cap, `2π(1 − cos α)` = `4π·sin²(α/2)`.
-pub fn cap_solid_angle(half_angle: f64) -> f64 {
-    let s = libm::sin(0.5 * half_angle);
-    4.0 * PI * s * s
+/// `ρ cos θᵢ` of a core model through its `Brdf` impl, for directions given in `f64`.
+pub fn core_eval<B: core_brdf::Brdf + ?Sized>(b: &B, wi: [f64; 3], wo: [f64; 3]) -> f32 {
+    let v = |d: [f64; 3]| steradian_core::Vec3::new(d[0] as f32, d[1] as f32, d[2] as f32);
+    b.eval(v(wi), v(wo))
 }

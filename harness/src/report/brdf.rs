@@ -18,6 +18,7 @@ use steradian_core::{Vec2, Vec3, rsl::hemisphere};
 
 use super::Options;
 use super::section::Section;
+use crate::reference::AsModel;
 use crate::reference::brdf::{self as rb, Model};
 use crate::rng::Rng;
 
@@ -135,11 +136,8 @@ fn time<F: FnMut() -> f32>(mut f: F) -> Duration {
 
 /// The models of the section.
 pub fn models() -> Vec<(String, Box<dyn Brdf>, Model)> {
-    fn m<B: Brdf + Copy + 'static>(name: &str, b: B) -> (String, Box<dyn Brdf>, Model)
-    where
-        Model: From<B>,
-    {
-        (name.to_string(), Box::new(b), Model::from(b))
+    fn m<B: Brdf + Copy + AsModel + 'static>(name: &str, b: B) -> (String, Box<dyn Brdf>, Model) {
+        (name.to_string(), Box::new(b), b.model())
     }
     // Parameters are valid constants: the constructors cannot fail on them.
     let ok = "valid BRDF parameters";

@@ -29,7 +29,8 @@ use steradian_core::lobe::{CosineLobe, Phong};
 use super::Options;
 use super::plot::{Pt, Scale, Series, chart};
 use super::section::Section;
-use crate::reference::triple::{self as reference, Cap, Lobe, Scene, Term, Visibility};
+use crate::reference as adapt;
+use crate::reference::triple::{self as reference, Scene, Term, Visibility};
 use crate::rng::Rng;
 
 /// Pruning thresholds, in units of the brightest unshadowed value of the scene.
@@ -136,22 +137,22 @@ fn build_points(bar: &ProgressBar) -> Result<Vec<Point>, Box<dyn Error>> {
             // the exact cosine.
             let [d, s] = phong.lobes(n, wo);
             let refl = vec![
-                Term::Lobe(Lobe::from_core(&d)),
-                Term::LobeTimesCosine(Lobe::from_core(&s), v3(n)),
+                Term::Lobe(adapt::lobe_of(&d)),
+                Term::LobeTimesCosine(adapt::lobe_of(&s), v3(n)),
             ];
             let lobe_ref = reference::triple(
                 &Scene {
                     reflectance: refl.clone(),
-                    light: reference::terms_of(&raw),
-                    visibility: Visibility::Lobes(reference::terms_of(&v)),
+                    light: adapt::terms_of(&raw),
+                    visibility: Visibility::Lobes(adapt::terms_of(&v)),
                 },
                 REF_TOL,
             );
             let phys_ref = reference::triple(
                 &Scene {
                     reflectance: refl,
-                    light: vec![Term::Cap(Cap::from_core(&cap), 1.0)],
-                    visibility: Visibility::Occluders(caps.iter().map(Cap::from_core).collect()),
+                    light: vec![Term::Cap(adapt::cap_of(&cap), 1.0)],
+                    visibility: Visibility::Occluders(caps.iter().map(adapt::cap_of).collect()),
                 },
                 REF_TOL,
             );

@@ -61,7 +61,7 @@
 
 use std::f64::consts::{FRAC_PI_2, PI, TAU};
 
-use super::quad::gk15;
+use crate::quad::gk15;
 
 /// `π − PI`: the f64 `PI` is `1.22e−16` below π.
 const PI_LO: f64 = 1.224_646_799_147_353_2e-16;

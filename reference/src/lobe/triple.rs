@@ -41,10 +41,7 @@
 
 use std::f64::consts::{FRAC_PI_2, PI, TAU};
 
-use super::quad::gk15;
-use steradian_core::lobe::CosineLobe;
-use steradian_core::lobe::cap::SphericalCap;
-use steradian_core::lobe::sum::LobeTerms;
+use crate::quad::gk15;
 
 /// A direction in f64.
 pub type V3 = [f64; 3];
@@ -84,15 +81,6 @@ impl Lobe {
             exponent,
         }
     }
-    /// The f32 lobe, widened (axis renormalised in f64).
-    pub fn from_core(l: &CosineLobe) -> Self {
-        let a = l.axis();
-        Lobe::new(
-            [a.x as f64, a.y as f64, a.z as f64],
-            l.scale() as f64,
-            l.exponent() as f64,
-        )
-    }
     /// `s·max(a·v, 0)^e`, `0` on and below the horizon.
     pub fn eval(&self, v: V3) -> f64 {
         let t = one_minus_dot(self.axis, v);
@@ -125,11 +113,6 @@ impl Cap {
             half_angle,
             one_minus_cos: 2.0 * s * s,
         }
-    }
-    /// The f32 cap, widened.
-    pub fn from_core(c: &SphericalCap) -> Self {
-        let a = c.axis();
-        Cap::new([a.x as f64, a.y as f64, a.z as f64], c.half_angle() as f64)
     }
     /// The cap of the sphere `(centre, radius)` seen from `point` (`sin α = r/d`), in f64.
     pub fn from_sphere(point: V3, centre: V3, radius: f64) -> Self {
@@ -201,19 +184,6 @@ impl Term {
             Term::Cap(c, x) => Term::Cap(c, x.abs()),
         }
     }
-}
-
-/// The terms of a core lobe sum (`k + Σ lobes`).
-pub fn terms_of(s: &impl LobeTerms) -> Vec<Term> {
-    let mut t: Vec<Term> = s
-        .lobes()
-        .iter()
-        .map(|l| Term::Lobe(Lobe::from_core(l)))
-        .collect();
-    if s.constant() != 0.0 {
-        t.insert(0, Term::Constant(s.constant() as f64));
-    }
-    t
 }
 
 /// The visibility factor.
@@ -682,7 +652,7 @@ fn adapt(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::reference::product::product_integral;
+    use crate::lobe::product::product_integral;
 
     fn rel(a: f64, b: f64) -> f64 {
         (a - b).abs() / b.abs().max(1e-300)

@@ -12,8 +12,6 @@
 
 use std::f64::consts::{FRAC_1_SQRT_2, PI};
 
-use steradian_core::lobe::brdf::{self, Brdf};
-
 /// A BRDF model with `f64` parameters.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Model {
@@ -60,55 +58,6 @@ pub enum Model {
         /// Roughness.
         alpha: f64,
     },
-}
-
-impl From<brdf::Lambert> for Model {
-    fn from(b: brdf::Lambert) -> Self {
-        Model::Lambert {
-            a: b.albedo() as f64,
-        }
-    }
-}
-impl From<brdf::Phong> for Model {
-    fn from(b: brdf::Phong) -> Self {
-        let (kd, ks, e) = b.params();
-        Model::Phong {
-            kd: kd as f64,
-            ks: ks as f64,
-            e: e as f64,
-        }
-    }
-}
-impl From<brdf::BlinnPhong> for Model {
-    fn from(b: brdf::BlinnPhong) -> Self {
-        let (kd, ks, e) = b.params();
-        Model::BlinnPhong {
-            kd: kd as f64,
-            ks: ks as f64,
-            e: e as f64,
-        }
-    }
-}
-impl From<brdf::Ward> for Model {
-    fn from(b: brdf::Ward) -> Self {
-        let (rd, rs, ax, ay) = b.params();
-        Model::Ward {
-            rd: rd as f64,
-            rs: rs as f64,
-            ax: ax as f64,
-            ay: ay as f64,
-        }
-    }
-}
-impl From<brdf::Ggx> for Model {
-    fn from(b: brdf::Ggx) -> Self {
-        let (kd, f0, alpha) = b.params();
-        Model::Ggx {
-            kd: kd as f64,
-            f0: f0 as f64,
-            alpha: alpha as f64,
-        }
-    }
 }
 
 fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
@@ -334,10 +283,4 @@ pub fn albedo(model: &Model, wo: [f64; 3], tol: f64) -> f64 {
 pub fn table_error(got: f64, exact: f64, albedo: f64, r: f64) -> f64 {
     let floor = albedo * 4.0 * r * r / (2.0 * PI);
     (got - exact).abs() / exact.max(floor)
-}
-
-/// `ρ cos θᵢ` of a core model through its `Brdf` impl, for directions given in `f64`.
-pub fn core_eval<B: Brdf + ?Sized>(b: &B, wi: [f64; 3], wo: [f64; 3]) -> f32 {
-    let v = |d: [f64; 3]| steradian_core::Vec3::new(d[0] as f32, d[1] as f32, d[2] as f32);
-    b.eval(v(wi), v(wo))
 }

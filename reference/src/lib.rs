@@ -1,0 +1,15 @@
+//! Exact `f64` references for every steradian kernel: closed forms where they exist,
+//! brute forces and adaptive quadrature where they do not. One reference per kernel, used
+//! by the harness (accuracy tables, table generators, the report), by the tests of
+//! `steradian-core`, `steradian-simd` and the harness, and by the fuzz targets.
+//!
+//! The folders mirror core's: [`lobe`] for the cosine-lobe paper, [`rsl`] for the
+//! rotatable-square-lights paper; [`quad`] is the shared quadrature rule. Nothing here
+//! depends on `steradian-core`: a reference written without the kernel's code checks the
+//! algebra as well as the rounding. Transcendental functions come from the pure-Rust `libm`
+//! crate where a result feeds a committed table, so those bytes are the same on every
+//! machine.
+
+pub mod lobe;
+pub mod quad;
+pub mod rsl;
