@@ -29,23 +29,7 @@ impl Rng {
 use crate::common::specials;
 use specials::SPECIALS;
 
-/// Bit-identical, or both NaN (payloads may differ).
-fn same(a: f32, b: f32) -> bool {
-    a.to_bits() == b.to_bits() || (a.is_nan() && b.is_nan())
-}
-
-/// Slice lengths the slice functions are run at.
-const LENGTHS: [usize; 6] = [0, 1, 7, 8, 9, 1000];
-
-/// Runs `check(rows)` on the rows with 0..8 filler rows in front, so every row lands in
-/// every lane position (and in the padded tail).
-fn in_every_lane<T: Copy>(rows: &[T], filler: T, mut check: impl FnMut(&[T])) {
-    for shift in 0..8 {
-        let mut r = vec![filler; shift];
-        r.extend_from_slice(rows);
-        check(&r);
-    }
-}
+use crate::common::lanes::{LENGTHS, in_every_lane, same};
 
 // ---------------------------------------------------------------------------------------
 // Kernels over rows: the scalar kernel, and the SIMD slice function on SoA columns.

@@ -36,10 +36,7 @@ fn batch(r: &[Raw; 8]) -> LobeX8 {
     LobeX8::new(Vec3x8::new(col(0), col(1), col(2)), col(3), col(4))
 }
 
-/// Bit-identical, or both NaN.
-fn same(a: f32, b: f32) -> bool {
-    a.to_bits() == b.to_bits() || (a.is_nan() && b.is_nan())
-}
+use crate::common::lanes::same;
 
 /// The differences of one lane, each divided by its bound's shape (so each must be ≤ its
 /// tolerance constant): `[scale, exponent, integral]`, plus whether the lane was exact.

@@ -1,0 +1,462 @@
+//! The rotatable-square-lights batch kernels lane by lane against their scalar kernels in
+//! `steradian-core`: SAT box and square queries and VDT queries bit-identical, the eq. 5
+//! shading and moments kernels within `shade::REL_TOL` / `shade::MOMENTS_REL_TOL` of the
+//! largest channel. Inputs: random tables and queries at every slice length, the named
+//! special values in every field and lane position, and the bad lanes (NaN views, views
+//! below the horizon, grazing views, tables of different sizes).
+
+use glam::{Vec2, Vec3};
+use steradian_core::frame::Frame;
+use steradian_core::lobe::brdf::{Brdf, Lambert, Phong};
+use steradian_core::rsl::Rsl;
+use steradian_core::rsl::brdf_sat::{BrdfSat, Resolution};
+use steradian_core::rsl::sat::{Sat, SatView};
+use steradian_core::rsl::shade::{self as core_shade, ShadeLight, VdtQuery, VdtVisibility};
+use steradian_core::rsl::vdt::{Vdt, VdtView};
+use steradian_core::rsl::vis_moments::VisMoments;
+use steradian_simd::rsl::shade::{
+    IsoBrdfTables, MOMENTS_REL_TOL, MomentsInput, REL_TOL, ShadeInput, shade_moments_x8, shade_x8,
+};
+use steradian_simd::rsl::{sat, vdt};
+
+use crate::common::lanes::{LENGTHS, in_every_lane, same};
+use crate::common::rng::Rng;
+use crate::common::specials::SPECIALS;
+
+/// Table sizes: single texels, single rows and columns, odd and even squares.
+const SIZES: [(usize, usize); 6] = [(1, 1), (1, 9), (9, 1), (17, 13), (64, 64), (300, 7)];
+
+fn special(rng: &mut Rng) -> f32 {
+    SPECIALS[(rng.next_u64() % SPECIALS.len() as u64) as usize]
+}
+
+/// A coordinate over `[−2, n + 2)`, a special value one time in eight.
+fn coord(rng: &mut Rng, n: usize) -> f32 {
+    if rng.next_u64() % 8 == 0 {
+        special(rng)
+    } else {
+        rng.range(-2.0, n as f32 + 2.0)
+    }
+}
+
+// ---- SAT ------------------------------------------------------------------------------
+
+fn random_sat(w: usize, h: usize, rng: &mut Rng) -> Sat {
+    let t: Vec<f32> = (0..w * h).map(|_| rng.range(-1.0, 1.0)).collect();
+    Sat::build(w, h, &t).expect("finite texels")
+}
+
+/// Columns of `rows`.
+fn cols<const N: usize>(rows: &[[f32; N]]) -> [Vec<f32>; N] {
+    core::array::from_fn(|c| rows.iter().map(|r| r[c]).collect())
+}
+
+/// `box_sum_slices` and `square_slices` (centre `(q0, q1)`, half-diagonal `q2`) against
+/// `SatView::box_sum` and `SatView::square`, bit for bit.
+fn check_sat(v: &SatView<'_>, rows: &[[f32; 4]]) {
+    let [u0, v0, u1, v1] = cols(rows);
+    let mut out = vec![0.0; rows.len()];
+    sat::box_sum_slices(v, &u0, &v0, &u1, &v1, &mut out);
+    for (k, q) in rows.iter().enumerate() {
+        let want = v.box_sum(q[0], q[1], q[2], q[3]);
+        assert!(
+            same(out[k], want),
+            "box lane {k} {q:?}: {} vs {want}",
+            out[k]
+        );
+    }
+    sat::square_slices(v, &u0, &v0, &u1, &mut out);
+    for (k, q) in rows.iter().enumerate() {
+        let want = v.square(Vec2::new(q[0], q[1]), q[2]);
+        assert!(
+            same(out[k], want),
+            "square lane {k} {q:?}: {} vs {want}",
+            out[k]
+        );
+    }
+}
+
+#[test]
+fn sat_random_queries_at_every_length() {
+    let mut rng = Rng(77);
+    for (w, h) in SIZES {
+        let s = random_sat(w, h, &mut rng);
+        for len in LENGTHS {
+            let rows: Vec<[f32; 4]> = (0..len)
+                .map(|_| {
+                    [
+                        coord(&mut rng, w),
+                        coord(&mut rng, h),
+                        coord(&mut rng, w),
+                        coord(&mut rng, h),
+                    ]
+                })
+                .collect();
+            check_sat(&s.view(), &rows);
+        }
+    }
+}
+
+#[test]
+fn sat_special_corners_in_every_lane() {
+    let mut rng = Rng(78);
+    let s = random_sat(17, 13, &mut rng);
+    let rows: Vec<[f32; 4]> = SPECIALS
+        .iter()
+        .flat_map(|&x| {
+            [
+                [x, 1.0, 2.5, 3.0],
+                [0.5, x, 2.0, 3.0],
+                [0.5, 0.5, x, 2.0],
+                [0.5, 0.5, 2.0, x],
+            ]
+        })
+        .collect();
+    in_every_lane(&rows, [0.5, 0.5, 1.5, 1.5], |r| check_sat(&s.view(), r));
+}
+
+/// Batches of 8 integer corners (the SIMD kernel's all-integer path: inside, on and past
+/// the far edges, `usize::MAX`), then the same batches with one lane NaN or fractional (the
+/// general path).
+#[test]
+fn sat_integer_corner_path_and_spoiled_lanes() {
+    let mut rng = Rng(0x1c0);
+    for (w, h) in SIZES {
+        let s = random_sat(w, h, &mut rng);
+        let mut c = |n: usize| -> f32 {
+            (match rng.next_u64() % 16 {
+                0 => n,
+                1 => n + 1 + (rng.next_u64() % 5) as usize,
+                2 => usize::MAX,
+                3 => 0,
+                _ => (rng.next_u64() % (n as u64 + 1)) as usize,
+            }) as f32
+        };
+        let rows: Vec<[f32; 4]> = (0..2000).map(|_| [c(w), c(h), c(w), c(h)]).collect();
+        for spoil in [None, Some(f32::NAN), Some(0.5f32)] {
+            let fq: Vec<[f32; 4]> = rows
+                .iter()
+                .enumerate()
+                .map(|(k, &q)| {
+                    let mut f = q;
+                    if let Some(x) = spoil.filter(|_| k % 8 == 3) {
+                        f[1] = if x.is_nan() { x } else { f[1] + x };
+                    }
+                    f
+                })
+                .collect();
+            check_sat(&s.view(), &fq);
+        }
+    }
+}
+
+// ---- VDT ------------------------------------------------------------------------------
+
+/// The table of a disc of occluded texels (centre `(cx, cy)`, radius `rad`, texel units).
+fn disc_vdt(w: usize, h: usize, cx: f32, cy: f32, rad: f32) -> Vdt {
+    let mask: Vec<bool> = (0..w * h)
+        .map(|k| {
+            let (x, y) = ((k % w) as f32 + 0.5 - cx, (k / w) as f32 + 0.5 - cy);
+            x * x + y * y > rad * rad
+        })
+        .collect();
+    Vdt::build(w, h, &mask).expect("valid shape")
+}
+
+/// `query_slices` against `VdtView::query`, both estimates bit for bit.
+fn check_vdt(v: &VdtView<'_>, rows: &[[f32; 3]]) {
+    let [u, w, r] = cols(rows);
+    let (mut e9, mut g) = (vec![0.0; rows.len()], vec![0.0; rows.len()]);
+    vdt::query_slices(v, &u, &w, &r, &mut e9, &mut g);
+    for (k, q) in rows.iter().enumerate() {
+        let (we, wg) = v.query(q[0], q[1], q[2]);
+        assert!(same(e9[k], we), "eq9 lane {k} {q:?}: {} vs {we}", e9[k]);
+        assert!(same(g[k], wg), "gradient lane {k} {q:?}: {} vs {wg}", g[k]);
+    }
+}
+
+#[test]
+fn vdt_random_queries_at_every_length() {
+    let mut rng = Rng(91);
+    for (w, h) in SIZES {
+        let t = disc_vdt(
+            w,
+            h,
+            0.4 * w as f32,
+            0.6 * h as f32,
+            0.3 * w.min(h) as f32 + 0.5,
+        );
+        for len in LENGTHS {
+            let rows: Vec<[f32; 3]> = (0..len)
+                .map(|_| {
+                    let r = if rng.next_u64() % 8 == 0 {
+                        special(&mut rng)
+                    } else {
+                        rng.range(0.0, 8.0)
+                    };
+                    [coord(&mut rng, w), coord(&mut rng, h), r]
+                })
+                .collect();
+            check_vdt(&t.view(), &rows);
+        }
+    }
+}
+
+#[test]
+fn vdt_special_values_in_every_lane() {
+    let t = disc_vdt(32, 32, 14.0, 17.0, 7.0);
+    let rows: Vec<[f32; 3]> = SPECIALS
+        .iter()
+        .flat_map(|&x| [[x, 16.0, 3.0], [16.0, x, 3.0], [16.0, 16.0, x]])
+        .collect();
+    in_every_lane(&rows, [10.0, 10.0, 2.0], |r| check_vdt(&t.view(), r));
+}
+
+// ---- Shading (eq. 5 and the moments kernel) ---------------------------------------------
+
+struct Setup {
+    sat: BrdfSat,
+    lights: Vec<ShadeLight>,
+    uniform: Vec<ShadeLight>,
+    vdts: Vec<Vdt>,
+    moments: Vec<VisMoments>,
+}
+
+const SIDE: usize = 32;
+
+fn setup(glossy: bool) -> Setup {
+    let mut rng = Rng(if glossy { 5 } else { 6 });
+    let brdf: Box<dyn Brdf> = if glossy {
+        Box::new(Phong::new(0.3, 0.5, 30.0).expect("valid"))
+    } else {
+        Box::new(Lambert::new(0.8).expect("valid"))
+    };
+    let res = Resolution {
+        grid: 32,
+        polar: 8,
+        azimuth: 1,
+    };
+    let sat = BrdfSat::build(brdf.as_ref(), res, core::f32::consts::FRAC_PI_2).expect("valid");
+    let (mut lights, mut uniform) = (Vec::new(), Vec::new());
+    while lights.len() < 12 {
+        let energy = [
+            rng.range(0.1, 2.0),
+            rng.range(0.1, 2.0),
+            rng.range(0.1, 2.0),
+        ];
+        let Ok(l) = Rsl::new(rng.dir(), rng.dir(), rng.log_range(1e-3, 0.6), energy) else {
+            continue;
+        };
+        let g = [rng.dir() * 0.3, rng.dir() * 0.2, rng.dir() * 0.1];
+        uniform.push(ShadeLight::from(&l));
+        lights.push(ShadeLight::from(
+            &l.with_gradient(g).expect("finite gradient"),
+        ));
+    }
+    let (mut vdts, mut moments) = (Vec::new(), Vec::new());
+    for _ in 0..8 {
+        let (cx, cy, rad) = (
+            rng.range(0.0, SIDE as f32),
+            rng.range(0.0, SIDE as f32),
+            rng.range(1.0, 12.0),
+        );
+        let mask: Vec<bool> = (0..SIDE * SIDE)
+            .map(|k| {
+                let (x, y) = ((k % SIDE) as f32 + 0.5 - cx, (k / SIDE) as f32 + 0.5 - cy);
+                x * x + y * y > rad * rad
+            })
+            .collect();
+        vdts.push(Vdt::build(SIDE, SIDE, &mask).expect("valid"));
+        moments.push(VisMoments::build(SIDE, &mask).expect("valid"));
+    }
+    Setup {
+        sat,
+        lights,
+        uniform,
+        vdts,
+        moments,
+    }
+}
+
+fn views(sat: &BrdfSat) -> Vec<SatView<'_>> {
+    (0..sat.resolution().polar)
+        .map(|k| sat.table(k, 0).expect("isotropic table").view())
+        .collect()
+}
+
+/// Eight random shading points: a frame and a view above its horizon, with one lane's view
+/// replaced by `special` when given (at lane `at`).
+fn points(rng: &mut Rng, special: Option<(usize, Vec3)>) -> [(Frame, Vec3); 8] {
+    core::array::from_fn(|k| {
+        let frame = Frame::from_normal(rng.dir()).expect("unit normal");
+        let mut d = rng.dir();
+        d.z = d.z.abs().max(1e-3);
+        let wo = match special {
+            Some((at, s)) if at == k => s,
+            _ => frame.to_world(d.normalize()),
+        };
+        (frame, wo)
+    })
+}
+
+/// Lane `k` within `tol` of the largest channel of the scalar result, or NaN in every
+/// channel of both.
+fn close(got: [f32; 3], want: [f32; 3], tol: f32) -> bool {
+    if want.iter().any(|x| x.is_nan()) {
+        return got.iter().chain(&want).all(|x| x.is_nan());
+    }
+    let m = want.iter().fold(0.0f32, |m, x| m.max(x.abs()));
+    (0..3).all(|c| (got[c] - want[c]).abs() <= tol * m.max(1e-30))
+}
+
+/// Views that are not ordinary: NaN, below the horizon (the negated normal is used when
+/// `None`), grazing, infinite and zero.
+fn special_views() -> Vec<Option<Vec3>> {
+    vec![
+        Some(Vec3::new(f32::NAN, 0.0, 1.0)),
+        None,
+        Some(Vec3::new(f32::INFINITY, 0.0, 0.0)),
+        Some(Vec3::ZERO),
+    ]
+}
+
+/// Checks every lane; returns how many lanes are lit (so a test can assert it shaded
+/// something).
+fn check_shade(s: &Setup, pts: &[(Frame, Vec3); 8], q: VdtQuery) -> usize {
+    let views = views(&s.sat);
+    let tables = IsoBrdfTables {
+        tables: &views,
+        s_max: s.sat.s_max(),
+    };
+    let input: [ShadeInput<'_>; 8] = core::array::from_fn(|k| ShadeInput {
+        frame: pts[k].0,
+        wo: pts[k].1,
+        vdt: s.vdts[k].view(),
+    });
+    let out = shade_x8(&input, &tables, q, &s.lights).expect("same sizes");
+    for (k, p) in input.iter().enumerate() {
+        let vis = VdtVisibility::new(p.vdt, q).expect("square table");
+        let want = core_shade::shade(&p.frame, p.wo, &s.sat, &vis, &s.lights);
+        assert!(
+            close(out[k], want, REL_TOL),
+            "{q:?} lane {k}: {:?} vs {want:?}",
+            out[k]
+        );
+    }
+    out.iter().filter(|o| o[0] > 0.0).count()
+}
+
+fn check_moments(s: &Setup, pts: &[(Frame, Vec3); 8], lights: &[ShadeLight]) -> usize {
+    let views = views(&s.sat);
+    let tables = IsoBrdfTables {
+        tables: &views,
+        s_max: s.sat.s_max(),
+    };
+    let input: [MomentsInput<'_>; 8] = core::array::from_fn(|k| MomentsInput {
+        frame: pts[k].0,
+        wo: pts[k].1,
+        vis: s.moments[k].view(),
+    });
+    let out = shade_moments_x8(&input, &tables, lights).expect("same sizes");
+    for (k, p) in input.iter().enumerate() {
+        let want = core_shade::shade_moments(&p.frame, p.wo, &s.sat, &p.vis, lights);
+        assert!(
+            close(out[k], want, MOMENTS_REL_TOL),
+            "moments lane {k}: {:?} vs {want:?}",
+            out[k]
+        );
+    }
+    out.iter().filter(|o| o[0] > 0.0).count()
+}
+
+#[test]
+fn shade_random_points_lane_by_lane() {
+    for glossy in [false, true] {
+        let s = setup(glossy);
+        let mut rng = Rng(17);
+        let mut lit = 0;
+        for _ in 0..64 {
+            let pts = points(&mut rng, None);
+            lit += check_shade(&s, &pts, VdtQuery::Eq9);
+            lit += check_shade(&s, &pts, VdtQuery::Gradient);
+            lit += check_moments(&s, &pts, &s.lights);
+            lit += check_moments(&s, &pts, &s.uniform);
+        }
+        // 12 lights over random hemispheres: nearly every point sees one.
+        assert!(lit > 4 * 64 * 8 * 3 / 4, "only {lit} lit lanes");
+    }
+}
+
+#[test]
+fn shade_special_views_in_every_lane() {
+    for glossy in [false, true] {
+        let s = setup(glossy);
+        let mut rng = Rng(18);
+        for view in special_views() {
+            for at in 0..8 {
+                let mut pts = points(&mut rng, None);
+                let wo = view.unwrap_or(-pts[at].0.normal());
+                pts[at].1 = wo;
+                check_shade(&s, &pts, VdtQuery::Gradient);
+                check_moments(&s, &pts, &s.lights);
+            }
+        }
+        // A grazing view, just above the horizon, in every lane.
+        for at in 0..8 {
+            let mut pts = points(&mut rng, None);
+            let f = pts[at].0;
+            pts[at].1 = (f.tangent() + 1e-6 * f.normal()).normalize();
+            check_shade(&s, &pts, VdtQuery::Eq9);
+            check_moments(&s, &pts, &s.lights);
+        }
+    }
+}
+
+/// A NaN view poisons only its lane (NaN, as the scalar kernel); a view below the horizon
+/// gives 0; tables of different sizes, or fewer than two BRDF tables, are refused.
+#[test]
+fn shade_bad_lanes_and_mismatched_tables() {
+    let s = setup(false);
+    let mut rng = Rng(19);
+    let mut pts = points(&mut rng, Some((3, Vec3::new(f32::NAN, 0.0, 1.0))));
+    pts[5].1 = -pts[5].0.normal();
+    let views = views(&s.sat);
+    let tables = IsoBrdfTables {
+        tables: &views,
+        s_max: s.sat.s_max(),
+    };
+    let mut input: [MomentsInput<'_>; 8] = core::array::from_fn(|k| MomentsInput {
+        frame: pts[k].0,
+        wo: pts[k].1,
+        vis: s.moments[k].view(),
+    });
+    let out = shade_moments_x8(&input, &tables, &s.lights).expect("same sizes");
+    assert!(out[3].iter().all(|x| x.is_nan()), "{:?}", out[3]);
+    assert_eq!(out[5], [0.0; 3]);
+    assert!(
+        out.iter()
+            .enumerate()
+            .all(|(k, o)| k == 3 || k == 5 || o[0] > 0.0)
+    );
+    let small = VisMoments::build(16, &vec![true; 256]).expect("valid");
+    input[7].vis = small.view();
+    assert!(shade_moments_x8(&input, &tables, &s.lights).is_none());
+
+    let other = Vdt::build(16, 16, &vec![true; 256]).expect("valid");
+    let mut input: [ShadeInput<'_>; 8] = core::array::from_fn(|k| ShadeInput {
+        frame: pts[k].0,
+        wo: pts[k].1,
+        vdt: s.vdts[k].view(),
+    });
+    let out = shade_x8(&input, &tables, VdtQuery::Gradient, &s.lights).expect("same sizes");
+    assert!(out[3].iter().all(|x| x.is_nan()));
+    assert_eq!(out[5], [0.0; 3]);
+    input[2].vdt = other.view();
+    assert!(shade_x8(&input, &tables, VdtQuery::Gradient, &s.lights).is_none());
+    input[2].vdt = s.vdts[2].view();
+    let one = IsoBrdfTables {
+        tables: &views[..1],
+        s_max: s.sat.s_max(),
+    };
+    assert!(shade_x8(&input, &one, VdtQuery::Gradient, &s.lights).is_none());
+}
