@@ -32,7 +32,7 @@ fn special(rng: &mut Rng) -> f32 {
 
 /// A coordinate over `[−2, n + 2)`, a special value one time in eight.
 fn coord(rng: &mut Rng, n: usize) -> f32 {
-    if rng.next_u64() % 8 == 0 {
+    if rng.next_u64().is_multiple_of(8) {
         special(rng)
     } else {
         rng.range(-2.0, n as f32 + 2.0)
@@ -189,7 +189,7 @@ fn vdt_random_queries_at_every_length() {
         for len in LENGTHS {
             let rows: Vec<[f32; 3]> = (0..len)
                 .map(|_| {
-                    let r = if rng.next_u64() % 8 == 0 {
+                    let r = if rng.next_u64().is_multiple_of(8) {
                         special(&mut rng)
                     } else {
                         rng.range(0.0, 8.0)
