@@ -36,6 +36,7 @@ use glam::{DVec2, DVec3, Vec2, Vec3};
 use steradian_core::frame::Frame;
 use steradian_core::lobe::brdf::Brdf;
 use steradian_core::rsl::brdf_sat::{BrdfSat, FitOptions};
+use steradian_core::rsl::shade::gpu as shade_gpu;
 use steradian_core::rsl::shade::{
     self, Moments, ShadeLight, VdtQuery, VdtVisibility, multi_product_bound,
 };
@@ -678,17 +679,7 @@ pub fn fit_sat(brdf: &dyn Brdf, decs: &[&Decomposition], target: f32) -> BrdfSat
     BrdfSat::fit(brdf, &o).expect("valid fit options")
 }
 
-/// The polar tables of an isotropic BRDF SAT as the SIMD and WGSL kernels read them
-/// (with [`BrdfSat::s_max`]). `None` for an anisotropic table.
-pub fn iso_views(sat: &BrdfSat) -> Option<Vec<steradian_core::rsl::sat::SatView<'_>>> {
-    let res = sat.resolution();
-    if res.azimuth != 1 {
-        return None;
-    }
-    (0..res.polar)
-        .map(|k| sat.table(k, 0).map(|t| t.view()))
-        .collect()
-}
+pub use steradian_core::rsl::shade::gpu::iso_views;
 
 /// The SIMD kernel's inputs: every point with its VDT (point `i` uses VDT `i`).
 pub fn simd_inputs<'a>(scene: &Scene, vdts: &'a [Vdt]) -> Vec<ShadeInput<'a>> {
@@ -765,89 +756,16 @@ pub fn shade_points_moments_simd(
     shade_moments_batch(&inputs, &tables, lights, &mut out).then_some(out)
 }
 
-/// The part of the binding-3 tables of `wgsl::SHADE` and `wgsl::SHADE_MOMENTS` before
-/// their per-point maps (shade_lib.wgsl): the header `[lights, grid, polar, s_max, map_n,
-/// off_lights, off_brdf, off_maps]` followed by `extra` header words, per light `[cx, cy,
-/// cz, r, 1/Ω, E_r, E_g, E_b]` (and its three gradients if `gradients`), then every BRDF
-/// table as its exponent word and entries ([`push_sat_words`]).
-fn gpu_shade_prefix(
-    sat: &BrdfSat,
-    views: &[steradian_core::rsl::sat::SatView<'_>],
-    lights: &[ShadeLight],
-    gradients: bool,
-    map_n: usize,
-    extra: &[u32],
-) -> Vec<u32> {
-    let grid = sat.resolution().grid;
-    let header = GPU_SHADE_HEADER + extra.len();
-    let light_words = if gradients {
-        GPU_MOMENTS_LIGHT_WORDS
-    } else {
-        GPU_SHADE_LIGHT_WORDS
-    };
-    let off_brdf = header + light_words * lights.len();
-    let off_maps = off_brdf + (1 + 2 * (grid + 1) * (grid + 1)) * views.len();
-    let mut w: Vec<u32> = vec![
-        lights.len() as u32,
-        grid as u32,
-        views.len() as u32,
-        sat.s_max().to_bits(),
-        map_n as u32,
-        header as u32,
-        off_brdf as u32,
-        off_maps as u32,
-    ];
-    w.extend(extra);
-    for l in lights {
-        let (c, e) = (l.centre(), l.energy());
-        let mut words = vec![c.x, c.y, c.z, l.half_diagonal(), l.inv_solid_angle()];
-        words.extend(e);
-        if gradients {
-            words.extend(l.gradient().iter().flat_map(|v| v.to_array()));
-        }
-        w.extend(words.into_iter().map(f32::to_bits));
-    }
-    for v in views {
-        push_sat_words(&mut w, v);
-    }
-    debug_assert_eq!(w.len(), off_maps);
-    w
-}
-
-/// A summed-area table as the shading kernels read it: its exponent word, then its entries
-/// as `(low, high)` word pairs (`SatView::gpu_words` after its header).
-fn push_sat_words(w: &mut Vec<u32>, v: &steradian_core::rsl::sat::SatView<'_>) {
-    w.push(v.exponent() as u32);
-    w.extend(
-        v.gpu_words()
-            .skip(steradian_core::rsl::sat::GPU_HEADER_WORDS),
-    );
-}
-
-/// The binding-3 table of `wgsl::SHADE` (its layout is documented there), as `f32` bits.
-/// `None` for an anisotropic BRDF SAT or VDTs of different sizes.
+/// The binding-3 table of `wgsl::SHADE` (`steradian_core::rsl::shade::gpu::shade_table`),
+/// as `f32` bits. `None` for an anisotropic BRDF SAT or VDTs of different sizes.
 pub fn gpu_table(
     sat: &BrdfSat,
     vdts: &[Vdt],
     lights: &[ShadeLight],
     query: VdtQuery,
 ) -> Option<Vec<f32>> {
-    let views = iso_views(sat)?;
-    let vn = vdts.first().map_or(1, |v| v.width());
-    if vdts.iter().any(|v| v.width() != vn || v.height() != vn) {
-        return None;
-    }
-    let mut w = gpu_shade_prefix(
-        sat,
-        &views,
-        lights,
-        false,
-        vn,
-        &[(query == VdtQuery::Gradient) as u32],
-    );
-    for v in vdts {
-        w.extend(v.samples().iter().map(|x| x.to_bits()));
-    }
+    let views: Vec<_> = vdts.iter().map(Vdt::view).collect();
+    let w = shade_gpu::shade_table(sat, &views, lights, query)?;
     Some(w.into_iter().map(f32::from_bits).collect())
 }
 
@@ -857,66 +775,28 @@ pub fn gpu_input(scene: &Scene) -> crate::kernels::Columns {
 }
 
 /// The input columns of `wgsl::SHADE` and `wgsl::SHADE_MOMENTS` for `points` (point `i`
-/// of the slice uses table `i` of the kernel's table).
+/// of the slice uses table `i` of the kernel's table; `shade::gpu::input_row`).
 pub fn gpu_input_points(points: &[ShadePoint]) -> crate::kernels::Columns {
-    let rows: Vec<[f32; 13]> = points
+    let rows: Vec<[f32; shade_gpu::INPUT_COLUMNS]> = points
         .iter()
         .enumerate()
-        .map(|(i, p)| {
-            let (t, b, n) = (p.frame.tangent(), p.frame.bitangent(), p.frame.normal());
-            [
-                t.x, t.y, t.z, b.x, b.y, b.z, n.x, n.y, n.z, p.wo.x, p.wo.y, p.wo.z, i as f32,
-            ]
-        })
+        .map(|(i, p)| shade_gpu::input_row(&p.frame, p.wo, i))
         .collect();
     crate::kernels::Columns::from_rows(&rows)
 }
 
-/// Words of `wgsl::SHADE_MOMENTS`'s table before the per-point tables (header, lights and
-/// BRDF tables), and the words per point, for a BRDF SAT with `polar` tables of side
-/// `grid`, `lights` lights and maps of side `vis_n`.
-fn gpu_moments_words(grid: usize, polar: usize, lights: usize, vis_n: usize) -> (usize, usize) {
-    let brdf = (1 + 2 * (grid + 1) * (grid + 1)) * polar;
-    let point = 3 * (1 + 2 * (vis_n + 1) * (vis_n + 1));
-    (
-        GPU_SHADE_HEADER + GPU_MOMENTS_LIGHT_WORDS * lights + brdf,
-        point,
-    )
-}
-
-/// Header words common to `wgsl::SHADE` and `wgsl::SHADE_MOMENTS` (shade_lib.wgsl).
-const GPU_SHADE_HEADER: usize = 8;
-/// Words per light of `wgsl::SHADE`'s table.
-const GPU_SHADE_LIGHT_WORDS: usize = 8;
-/// Words per light of `wgsl::SHADE_MOMENTS`'s table.
-const GPU_MOMENTS_LIGHT_WORDS: usize = 17;
-
-/// The binding-3 table of `wgsl::SHADE_MOMENTS` (its layout is documented there), as `f32`
-/// bits, for the points whose moment tables are `moments` (the kernel's point index `i`
-/// reads `moments[i]`). `None` for an anisotropic BRDF SAT or maps of different sizes.
-/// 1.6 MB per point at `n = 256`: [`shade_points_moments_gpu`] splits a batch so that each
-/// table stays within a byte limit.
+/// The binding-3 table of `wgsl::SHADE_MOMENTS`
+/// (`steradian_core::rsl::shade::gpu::moments_table`), as `f32` bits, for the points whose
+/// moment tables are `moments`. `None` for an anisotropic BRDF SAT or maps of different
+/// sizes. 1.6 MB per point at `n = 256`: [`shade_points_moments_gpu`] splits a batch so
+/// that each table stays within a byte limit.
 pub fn gpu_moments_table(
     sat: &BrdfSat,
     moments: &[&VisMoments],
     lights: &[ShadeLight],
 ) -> Option<Vec<f32>> {
-    let views = iso_views(sat)?;
-    let grid = sat.resolution().grid;
-    let vn = moments.first().map_or(1, |m| m.side());
-    if moments.iter().any(|m| m.side() != vn) {
-        return None;
-    }
-    let (fixed, per_point) = gpu_moments_words(grid, views.len(), lights.len(), vn);
-    let mut w = gpu_shade_prefix(sat, &views, lights, true, vn, &[]);
-    debug_assert_eq!(w.len(), fixed);
-    w.reserve(per_point * moments.len());
-    for m in moments {
-        for t in &m.tables() {
-            push_sat_words(&mut w, t);
-        }
-    }
-    debug_assert_eq!(w.len(), fixed + per_point * moments.len());
+    let views: Vec<_> = moments.iter().map(|m| m.view()).collect();
+    let w = shade_gpu::moments_table(sat, &views, lights)?;
     Some(w.into_iter().map(f32::from_bits).collect())
 }
 
@@ -947,7 +827,8 @@ pub fn shade_points_moments_gpu(
     }
     let polar = iso_views(sat).map_or(0, |v| v.len());
     let vn = moments.first().map_or(1, VisMoments::side);
-    let (fixed, per_point) = gpu_moments_words(sat.resolution().grid, polar, lights.len(), vn);
+    let (fixed, per_point) =
+        shade_gpu::moments_words(sat.resolution().grid, polar, lights.len(), vn);
     let chunk = (max_table_bytes / 4).saturating_sub(fixed) / per_point;
     let chunk = chunk.max(1);
     let mut out = Vec::with_capacity(moments.len());

@@ -150,6 +150,21 @@ impl<'a> ProductTable<'a> {
         self.payload.len()
     }
 
+    /// The table in the layout of `wgsl::LOBE_PRODUCT` (binding 3): `[exponents, angles]` as
+    /// `f32`, then every value of the packed layout in order.
+    #[cfg(feature = "alloc")]
+    pub fn gpu_table(&self) -> alloc::vec::Vec<f32> {
+        let mut t = alloc::vec::Vec::with_capacity(2 + self.payload.len() / 4);
+        t.push(self.exponents as f32);
+        t.push(self.angles as f32);
+        t.extend(
+            self.payload
+                .chunks_exact(4)
+                .map(|b| f32::from_le_bytes([b[0], b[1], b[2], b[3]])),
+        );
+        t
+    }
+
     /// Value `idx` of the packed layout (0 outside, which validation rules out).
     #[inline(always)]
     pub fn value(&self, idx: usize) -> f32 {

@@ -503,6 +503,183 @@ pub fn multi_product_bound(area: f64, l: &Moments, v: &Moments, rho: &Moments) -
             + l.third * v.third * rho.third)
 }
 
+/// The GPU layouts of the shading kernels' binding-3 tables (`wgsl::SHADE`,
+/// `wgsl::SHADE_MOMENTS`; shade_lib.wgsl reads them), packed from the tables the scalar
+/// kernels read. All words are `u32` (floats as their bits).
+///
+/// Layout: the header `[lights, grid, polar, s_max, map_n, off_lights, off_brdf, off_maps]`
+/// (plus one word, `1` for the gradient VDT query, in `wgsl::SHADE`'s), per light
+/// `[cx, cy, cz, r, 1/Ω, E_r, E_g, E_b]` (and its three radiance gradients in
+/// `wgsl::SHADE_MOMENTS`'s), every isotropic BRDF table as its exponent word and its
+/// entries ([`crate::rsl::sat::SatView::gpu_words`] after its header), then the per-point
+/// maps: each VDT's samples, or each point's three moment tables as the BRDF tables.
+#[cfg(feature = "alloc")]
+pub mod gpu {
+    use alloc::vec::Vec;
+
+    use super::{ShadeLight, VdtQuery};
+    use crate::Vec3;
+    use crate::frame::Frame;
+    use crate::rsl::brdf_sat::BrdfSat;
+    use crate::rsl::sat::{GPU_HEADER_WORDS, SatView};
+    use crate::rsl::vdt::VdtView;
+    use crate::rsl::vis_moments::VisMomentsView;
+
+    /// Header words common to both layouts.
+    pub const HEADER_WORDS: usize = 8;
+    /// Words per light of `wgsl::SHADE`'s table.
+    pub const SHADE_LIGHT_WORDS: usize = 8;
+    /// Words per light of `wgsl::SHADE_MOMENTS`'s table (eight plus three gradients).
+    pub const MOMENTS_LIGHT_WORDS: usize = 17;
+    /// Columns of the kernels' input rows ([`input_row`]).
+    pub const INPUT_COLUMNS: usize = 13;
+
+    /// The isotropic BRDF tables' views, `None` for an anisotropic BRDF SAT.
+    pub fn iso_views(sat: &BrdfSat) -> Option<Vec<SatView<'_>>> {
+        let res = sat.resolution();
+        if res.azimuth != 1 {
+            return None;
+        }
+        (0..res.polar)
+            .map(|k| sat.table(k, 0).map(|t| t.view()))
+            .collect()
+    }
+
+    /// Words of a summed-area table in the shading layout: `1 + 2·(side + 1)²`.
+    fn sat_words(side: usize) -> usize {
+        1 + 2 * (side + 1) * (side + 1)
+    }
+
+    fn push_sat(w: &mut Vec<u32>, v: &SatView<'_>) {
+        w.push(v.exponent() as u32);
+        w.extend(v.gpu_words().skip(GPU_HEADER_WORDS));
+    }
+
+    /// Header, lights and BRDF tables (everything before the per-point maps).
+    fn prefix(
+        sat: &BrdfSat,
+        views: &[SatView<'_>],
+        lights: &[ShadeLight],
+        gradients: bool,
+        map_n: usize,
+        extra: &[u32],
+    ) -> Vec<u32> {
+        let grid = sat.resolution().grid;
+        let header = HEADER_WORDS + extra.len();
+        let light_words = if gradients {
+            MOMENTS_LIGHT_WORDS
+        } else {
+            SHADE_LIGHT_WORDS
+        };
+        let off_brdf = header + light_words * lights.len();
+        let off_maps = off_brdf + sat_words(grid) * views.len();
+        let mut w: Vec<u32> = Vec::with_capacity(off_maps);
+        w.extend([
+            lights.len() as u32,
+            grid as u32,
+            views.len() as u32,
+            sat.s_max().to_bits(),
+            map_n as u32,
+            header as u32,
+            off_brdf as u32,
+            off_maps as u32,
+        ]);
+        w.extend(extra);
+        for l in lights {
+            let (c, e) = (l.centre(), l.energy());
+            let head = [c.x, c.y, c.z, l.half_diagonal(), l.inv_solid_angle()];
+            w.extend(head.iter().chain(&e).map(|x| x.to_bits()));
+            if gradients {
+                let g = l.gradient();
+                w.extend(g.iter().flat_map(|v| v.to_array()).map(f32::to_bits));
+            }
+        }
+        for v in views {
+            push_sat(&mut w, v);
+        }
+        debug_assert_eq!(w.len(), off_maps);
+        w
+    }
+
+    /// The table of `wgsl::SHADE`: point `i` of the kernel reads `vdts[i]`. `None` for an
+    /// anisotropic BRDF SAT or VDTs that are not all square of one side.
+    pub fn shade_table(
+        sat: &BrdfSat,
+        vdts: &[VdtView<'_>],
+        lights: &[ShadeLight],
+        query: VdtQuery,
+    ) -> Option<Vec<u32>> {
+        let views = iso_views(sat)?;
+        let vn = vdts.first().map_or(1, |v| v.width());
+        if vdts.iter().any(|v| v.width() != vn || v.height() != vn) {
+            return None;
+        }
+        let extra = [(query == VdtQuery::Gradient) as u32];
+        let mut w = prefix(sat, &views, lights, false, vn, &extra);
+        for v in vdts {
+            w.extend(v.samples().iter().map(|x| x.to_bits()));
+        }
+        Some(w)
+    }
+
+    /// Words of `wgsl::SHADE_MOMENTS`'s table before the per-point tables, and the words
+    /// per point, for `polar` BRDF tables of side `grid`, `lights` lights and moment maps of
+    /// side `map_n` (to split a batch under a buffer limit before packing it).
+    pub fn moments_words(grid: usize, polar: usize, lights: usize, map_n: usize) -> (usize, usize) {
+        (
+            HEADER_WORDS + MOMENTS_LIGHT_WORDS * lights + sat_words(grid) * polar,
+            3 * sat_words(map_n),
+        )
+    }
+
+    /// The table of `wgsl::SHADE_MOMENTS`: point `i` of the kernel reads `moments[i]`.
+    /// `None` for an anisotropic BRDF SAT or moment maps of different sides.
+    pub fn moments_table(
+        sat: &BrdfSat,
+        moments: &[VisMomentsView<'_>],
+        lights: &[ShadeLight],
+    ) -> Option<Vec<u32>> {
+        let views = iso_views(sat)?;
+        let vn = moments.first().map_or(1, |m| m.side());
+        if moments.iter().any(|m| m.side() != vn) {
+            return None;
+        }
+        let grid = sat.resolution().grid;
+        let (fixed, per_point) = moments_words(grid, views.len(), lights.len(), vn);
+        let mut w = prefix(sat, &views, lights, true, vn, &[]);
+        debug_assert_eq!(w.len(), fixed);
+        w.reserve(per_point * moments.len());
+        for m in moments {
+            for t in &m.tables() {
+                push_sat(&mut w, t);
+            }
+        }
+        debug_assert_eq!(w.len(), fixed + per_point * moments.len());
+        Some(w)
+    }
+
+    /// One row of the kernels' input columns: `[tx, ty, tz, bx, by, bz, nx, ny, nz, wox,
+    /// woy, woz, point]` (the point's index into the per-point maps, as `f32`).
+    pub fn input_row(frame: &Frame, wo: Vec3, point: usize) -> [f32; INPUT_COLUMNS] {
+        let (t, b, n) = (frame.tangent(), frame.bitangent(), frame.normal());
+        [
+            t.x,
+            t.y,
+            t.z,
+            b.x,
+            b.y,
+            b.z,
+            n.x,
+            n.y,
+            n.z,
+            wo.x,
+            wo.y,
+            wo.z,
+            point as f32,
+        ]
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -666,6 +843,57 @@ mod tests {
             assert_eq!(a[ch].min(z[ch]), 0.0, "{a:?} {z:?}");
             assert!(a[ch].max(z[ch]) > 0.0, "{a:?} {z:?}");
         }
+    }
+
+    /// The GPU tables have the documented layout: header offsets that match the word
+    /// counts, the lights' words where the header says, the per-point maps at the end.
+    #[cfg(feature = "alloc")]
+    #[test]
+    fn gpu_tables_follow_the_documented_layout() {
+        use crate::lobe::brdf::Lambert;
+        use crate::rsl::brdf_sat::{BrdfSat, Resolution};
+        use crate::rsl::vdt::Vdt;
+        use crate::rsl::vis_moments::VisMoments;
+        let res = Resolution {
+            grid: 4,
+            polar: 3,
+            azimuth: 1,
+        };
+        let sat = BrdfSat::build(&Lambert::new(0.5).unwrap(), res, 1.2).unwrap();
+        let l = Rsl::new(Vec3::new(0.2, 0.1, 1.0), Vec3::X, 0.05, [1.0, 2.0, 3.0]).unwrap();
+        let lights = [ShadeLight::from(&l); 2];
+        let mask = [true, false, true, true, true, false, false, true, true];
+        let vdts = [
+            Vdt::build(3, 3, &mask).unwrap(),
+            Vdt::build(3, 3, &mask).unwrap(),
+        ];
+        let views: alloc::vec::Vec<_> = vdts.iter().map(|v| v.view()).collect();
+        let w = gpu::shade_table(&sat, &views, &lights, VdtQuery::Gradient).unwrap();
+        let brdf_words: u32 = 3 * (1 + 2 * 5 * 5);
+        let (off_lights, off_brdf, off_maps) = (9, 9 + 2 * 8, 9 + 2 * 8 + brdf_words);
+        assert_eq!(&w[..3], &[2, 4, 3]);
+        assert_eq!(f32::from_bits(w[3]), sat.s_max());
+        assert_eq!(&w[4..9], &[3, off_lights, off_brdf, off_maps, 1]);
+        assert_eq!(
+            f32::from_bits(w[off_lights as usize + 3]),
+            lights[0].half_diagonal()
+        );
+        assert_eq!(w.len(), off_maps as usize + 2 * 9);
+        assert_eq!(f32::from_bits(w[off_maps as usize]), vdts[0].samples()[0]);
+        let moments = [VisMoments::build(3, &mask).unwrap()];
+        let mv: alloc::vec::Vec<_> = moments.iter().map(|m| m.view()).collect();
+        let m = gpu::moments_table(&sat, &mv, &lights).unwrap();
+        let (fixed, per_point) = gpu::moments_words(4, 3, 2, 3);
+        assert_eq!(
+            (fixed, per_point),
+            (8 + 2 * 17 + brdf_words as usize, 3 * (1 + 2 * 4 * 4))
+        );
+        assert_eq!(m.len(), fixed + per_point);
+        assert_eq!(&m[4..8], &[3, 8, 8 + 2 * 17, fixed as u32]);
+        // VDTs of different sides are refused.
+        let other = Vdt::build(1, 1, &[true]).unwrap();
+        let mixed = [vdts[0].view(), other.view()];
+        assert!(gpu::shade_table(&sat, &mixed, &lights, VdtQuery::Eq9).is_none());
     }
 
     #[test]

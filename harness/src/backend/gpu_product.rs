@@ -2,13 +2,14 @@
 //! `product::product_with` with `ProductFit::ExactIntegral`) run through [`Gpu::run_custom`]
 //! with the product table at binding 3 as `[exponents, angles, g…]` in `f32`.
 //!
+//! The table layout is core's (`ProductTable::gpu_table`).
+//!
 //! [`run_lobe_product_gpu`] is the convenience the report and the tests time: lobes in,
 //! lobes out, one full round trip (upload of the batch and of the table, dispatch,
 //! read-back). [`ProductGpuTable`] decodes a table once for repeated runs.
 
 use steradian_core::lobe::CosineLobe;
 use steradian_core::lobe::product::{self, ProductTable};
-use steradian_core::table::TableView;
 use steradian_core::{Vec3, wgsl};
 
 use super::BackendError;
@@ -30,11 +31,7 @@ impl ProductGpuTable {
     pub fn from_bytes(bytes: &[u8]) -> Result<Self, BackendError> {
         let bad = |e: &dyn std::fmt::Debug| BackendError(format!("lobe-product table: {e:?}"));
         let t = ProductTable::from_bytes(bytes).map_err(|e| bad(&e))?;
-        let view = TableView::parse(bytes).map_err(|e| bad(&e))?;
-        let mut data = vec![0.0f32; 2 + view.len()];
-        data[0] = t.exponents() as f32;
-        data[1] = t.angles() as f32;
-        view.copy_to(&mut data[2..]).map_err(|e| bad(&e))?;
+        let data = t.gpu_table();
         Ok(ProductGpuTable(data))
     }
 
