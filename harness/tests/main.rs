@@ -17,4 +17,5 @@ mod shade;
 mod shade_moments_gpu;
 mod vdt;
 mod vdt_gpu;
+mod wgsl_layout;
 mod wgsl_validate;

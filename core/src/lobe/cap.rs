@@ -121,6 +121,8 @@ pub enum CapFit {
 
 /// A spherical cap: unit axis and half-angle `α ∈ (0, π]`.
 #[derive(Clone, Copy, Debug, PartialEq)]
+#[repr(C)]
+#[cfg_attr(feature = "bytemuck", derive(bytemuck::Pod, bytemuck::Zeroable))]
 pub struct SphericalCap {
     axis: Vec3,
     half_angle: f32,
@@ -128,6 +130,23 @@ pub struct SphericalCap {
 }
 
 impl SphericalCap {
+    /// The byte layout of the `#[repr(C)]` type, which `wgsl::TYPES` declares as `SphericalCap`.
+    pub const LAYOUT: crate::wgsl::Layout = crate::wgsl::Layout {
+        name: "SphericalCap",
+        size: core::mem::size_of::<SphericalCap>(),
+        fields: &[
+            ("axis", core::mem::offset_of!(SphericalCap, axis)),
+            (
+                "half_angle",
+                core::mem::offset_of!(SphericalCap, half_angle),
+            ),
+            (
+                "one_minus_cos",
+                core::mem::offset_of!(SphericalCap, one_minus_cos),
+            ),
+        ],
+    };
+
     /// A cap from its axis (non-zero, finite; normalised here) and half-angle in `(0, π]`.
     pub fn new(axis: Vec3, half_angle: f32) -> Result<Self, Error> {
         let axis = check_dir(axis, "cap axis")?;

@@ -38,6 +38,8 @@ pub const INTEGRAL_REL_ERROR: f32 = 2.5e-7;
 
 /// A cosine lobe `s·max(a·v, 0)^e` with unit axis, finite scale and finite exponent `≥ 0`.
 #[derive(Clone, Copy, Debug, PartialEq)]
+#[repr(C)]
+#[cfg_attr(feature = "bytemuck", derive(bytemuck::Pod, bytemuck::Zeroable))]
 pub struct CosineLobe {
     axis: Vec3,
     scale: f32,
@@ -45,6 +47,17 @@ pub struct CosineLobe {
 }
 
 impl CosineLobe {
+    /// The byte layout of the `#[repr(C)]` type, which `wgsl::TYPES` declares as `CosineLobe`.
+    pub const LAYOUT: crate::wgsl::Layout = crate::wgsl::Layout {
+        name: "CosineLobe",
+        size: core::mem::size_of::<CosineLobe>(),
+        fields: &[
+            ("axis", core::mem::offset_of!(CosineLobe, axis)),
+            ("scale", core::mem::offset_of!(CosineLobe, scale)),
+            ("exponent", core::mem::offset_of!(CosineLobe, exponent)),
+        ],
+    };
+
     /// Validating constructor: `axis` finite and non-zero (normalised here), `scale` finite
     /// (negative scales are allowed: visibility is `1 − Σ w·c`), `exponent` finite and `≥ 0`.
     pub fn new(axis: Vec3, scale: f32, exponent: f32) -> Result<Self, Error> {

@@ -106,6 +106,8 @@ pub const MAX_SOLID_ANGLE: f32 = 4.0 * crate::PI;
 
 /// A rotatable square light: centre direction, orientation, solid angle and light integral.
 #[derive(Clone, Copy, Debug, PartialEq)]
+#[repr(C)]
+#[cfg_attr(feature = "bytemuck", derive(bytemuck::Pod, bytemuck::Zeroable))]
 pub struct Rsl {
     centre: Vec3,
     tangent: Vec3,
@@ -115,6 +117,19 @@ pub struct Rsl {
 }
 
 impl Rsl {
+    /// The byte layout of the `#[repr(C)]` type, which `wgsl::TYPES` declares as `Rsl`.
+    pub const LAYOUT: crate::wgsl::Layout = crate::wgsl::Layout {
+        name: "Rsl",
+        size: core::mem::size_of::<Rsl>(),
+        fields: &[
+            ("centre", core::mem::offset_of!(Rsl, centre)),
+            ("tangent", core::mem::offset_of!(Rsl, tangent)),
+            ("solid_angle", core::mem::offset_of!(Rsl, solid_angle)),
+            ("energy", core::mem::offset_of!(Rsl, energy)),
+            ("gradient", core::mem::offset_of!(Rsl, gradient)),
+        ],
+    };
+
     /// A validated RSL. `centre` is normalised; `tangent` is made orthogonal to it
     /// (Gram–Schmidt) and normalised; `solid_angle` must lie in `[f32::MIN_POSITIVE, 4π]`
     /// (a subnormal one has no finite reciprocal); each `energy` channel (the light

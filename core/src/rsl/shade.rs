@@ -243,6 +243,8 @@ impl SquareVisibility for VdtVisibility<'_> {
 /// spends no square root or division on them; the fields are private so that they always
 /// agree with the light's solid angle).
 #[derive(Clone, Copy, Debug, PartialEq)]
+#[repr(C)]
+#[cfg_attr(feature = "bytemuck", derive(bytemuck::Pod, bytemuck::Zeroable))]
 pub struct ShadeLight {
     centre: Vec3,
     half_diagonal: f32,
@@ -264,6 +266,25 @@ impl From<&Rsl> for ShadeLight {
 }
 
 impl ShadeLight {
+    /// The byte layout of the `#[repr(C)]` type, which `wgsl::TYPES` declares as `ShadeLight`.
+    pub const LAYOUT: crate::wgsl::Layout = crate::wgsl::Layout {
+        name: "ShadeLight",
+        size: core::mem::size_of::<ShadeLight>(),
+        fields: &[
+            ("centre", core::mem::offset_of!(ShadeLight, centre)),
+            (
+                "half_diagonal",
+                core::mem::offset_of!(ShadeLight, half_diagonal),
+            ),
+            (
+                "inv_solid_angle",
+                core::mem::offset_of!(ShadeLight, inv_solid_angle),
+            ),
+            ("energy", core::mem::offset_of!(ShadeLight, energy)),
+            ("gradient", core::mem::offset_of!(ShadeLight, gradient)),
+        ],
+    };
+
     /// Unit centre direction (world).
     #[inline]
     pub fn centre(&self) -> Vec3 {

@@ -13,8 +13,13 @@
 //! @group(0) @binding(0) var<storage, read> input: array<f32>;        // column-major
 //! @group(0) @binding(1) var<storage, read_write> output: array<f32>; // column-major
 //! @group(0) @binding(2) var<uniform> params: Params;
-//! @group(0) @binding(3) var<storage, read> table: array<f32>;        // cap-exponent only
+//! @group(0) @binding(3) var<storage, read> table: array<f32>;        // or array<u32>
 //! ```
+//!
+//! Binding 3 is the kernel's table: the cap-exponent table in [`CAP_EXPONENT`], a
+//! caller-supplied table for the kernels of [`CUSTOM`] (its element type listed there, its
+//! layout documented at each constant and packed in core beside the table it holds);
+//! the other kernels of [`ALL`] declare none.
 //!
 //! A batch of `n` rows is structure-of-arrays: input column `c` of row `i` is
 //! `input[c·n + i]`, output column `c` is `output[c·n + i]`. Thread `gid` handles row
@@ -47,6 +52,24 @@
 //! random and hand-picked finite inputs. The values were measured on lavapipe (Mesa
 //! llvmpipe, Vulkan) with some margin; a driver with worse transcendental functions may
 //! need more.
+
+/// The types a renderer uploads (`CosineLobe`, `SphericalCap`, `Rsl`, `ShadeLight`) as WGSL
+/// structs with the byte layout of the `#[repr(C)]` Rust types (each type's `LAYOUT`, a
+/// [`Layout`]); no entry point, for a renderer to prepend to its own shaders.
+pub const TYPES: &str = include_str!("types.wgsl");
+
+/// The byte layout of a `#[repr(C)]` type that has a WGSL twin in [`TYPES`]: its size and
+/// each field's offset, from `size_of` and `offset_of!` (the harness compares them with
+/// naga's layout of the WGSL struct).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Layout {
+    /// The struct's name, in Rust and in [`TYPES`].
+    pub name: &'static str,
+    /// `size_of`, bytes.
+    pub size: usize,
+    /// `(field, offset in bytes)`, in declaration order.
+    pub fields: &'static [(&'static str, usize)],
+}
 
 /// Equal-area hemisphere map, direction → disk point (`hemisphere::map`).
 /// Input columns `[x, y, z]`, output `[u, v]`.
