@@ -10,7 +10,7 @@
 //! | [`lobe`] | [`lobe::eval`], [`lobe::eval_parts`] | `eval_slices` | within [`lobe::EVAL_REL_TOL`] |
 //! | [`lobe::cap`] | [`lobe::cap::exponent_l2`], [`lobe::cap::lookup`] | `exponent_l2_slices`, `lookup_slices` | bit-identical |
 //! | [`lobe::product`] | [`lobe::product::product_x8`] | `product_slices` | axis bit-identical; scale, exponent within [`lobe::product::SCALE_REL_TOL`] etc. |
-//! | [`rsl::sat`] | [`rsl::sat::box_sum`] | `box_sum_slices`, `square_slices` | bit-identical |
+//! | [`rsl::sat`] | [`rsl::sat::box_sum`], [`rsl::sat::square`] | `box_sum_slices`, `square_slices` | bit-identical |
 //! | [`rsl::vdt`] | [`rsl::vdt::query`] | `query_slices` | bit-identical |
 //! | [`rsl::shade`] | [`rsl::shade::shade_x8`], [`rsl::shade::shade_moments_x8`] | `shade_batch`, `shade_moments_batch` | within [`rsl::shade::REL_TOL`], [`rsl::shade::MOMENTS_REL_TOL`] |
 //!
@@ -48,7 +48,8 @@
 //!   takes its horizon branch, exactly `s` when `e = 0`, and NaN exactly where the scalar
 //!   kernel is NaN.
 //!
-//! The tests (`tests/contract.rs`) check the contract lane by lane on pseudo-random inputs,
+//! The tests (one binary, `tests/main.rs`: `contract` for the lobe and hemisphere kernels,
+//! `product`, `rsl` for SAT, VDT and shading) check the contract lane by lane on pseudo-random inputs,
 //! arbitrary bit patterns, named special values in every lane position, and slice lengths
 //! around the vector sizes (0, 1, 7, 8, 9, 1000); the cap lookup also on every `f32`
 //! (`cargo test --release -p steradian-simd -- --ignored`).

@@ -55,6 +55,22 @@
 //! NaN, `0` when `wᵢ` or `wₒ` is on or below the horizon (`z ≤ 0`). Non-unit inputs are not
 //! normalised (the caller's frame transform produces unit vectors); the result is finite for
 //! any finite input. Constructors validate parameters and return [`Error`].
+//!
+//! # References
+//!
+//! - R. R. Lewis, "Making shaders more physically plausible", *Computer Graphics Forum*
+//!   13(2), pp. 109–120, 1994. DOI: 10.1111/1467-8659.1320109.
+//! - J. F. Blinn, "Models of light reflection for computer synthesized pictures",
+//!   *SIGGRAPH '77* (Computer Graphics 11(2)), pp. 192–198, 1977.
+//!   DOI: 10.1145/965141.563893.
+//! - G. J. Ward, "Measuring and modeling anisotropic reflection", *SIGGRAPH '92*
+//!   (Computer Graphics 26(2)), pp. 265–272, 1992.
+//! - R. L. Cook, K. E. Torrance, "A reflectance model for computer graphics", *ACM
+//!   Transactions on Graphics* 1(1), pp. 7–24, 1982. DOI: 10.1145/357290.357293.
+//! - B. Walter, S. R. Marschner, H. Li, K. E. Torrance, "Microfacet models for refraction
+//!   through rough surfaces", *Eurographics Symposium on Rendering*, 2007.
+//! - C. Schlick, "An inexpensive BRDF model for physically-based rendering", *Computer
+//!   Graphics Forum* 13(3), pp. 233–246, 1994. DOI: 10.1111/1467-8659.1330233.
 
 use crate::lobe;
 use crate::math;

@@ -18,6 +18,19 @@
 //! does better there.
 //!
 //! **Integral.** [`integral`] is within [`INTEGRAL_REL_ERROR`] relative (two roundings).
+//!
+//! # References
+//!
+//! - S. Meunier, R. Perrot, L. Aveneau, D. Meneveaux, D. Ghazanfarpour, "Cosine lobes for
+//!   interactive direct lighting in dynamic scenes", *Computers & Graphics* 34(6),
+//!   pp. 767–778, 2010. DOI: 10.1016/j.cag.2010.08.002. The equation numbers cited in this
+//!   folder are those of the earlier technical report (XLIM, HAL hal-00401728, 2009), the
+//!   text this crate implements.
+//! - R. R. Lewis, "Making shaders more physically plausible", *Computer Graphics Forum*
+//!   13(2), pp. 109–120, 1994. DOI: 10.1111/1467-8659.1320109 (the modified Phong model).
+//! - E. P. F. Lafortune, S.-C. Foo, K. E. Torrance, D. P. Greenberg, "Non-linear
+//!   approximation of reflectance functions", *SIGGRAPH 97 Conference Proceedings*,
+//!   pp. 117–126, 1997 (the Lafortune lobes).
 
 pub mod brdf;
 pub mod cap;

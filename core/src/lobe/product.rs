@@ -3,7 +3,9 @@
 //!
 //! **Geometry (closed form, exact).** The product peaks on the great arc from `a1` to
 //! `a2`, at the angle `t*` from `a1` with `sin(2t* − α) = ((e2 − e1)/(e1 + e2))·sin α`
-//! (DESIGN.md); the result axis `a_r` is that direction and `p` is the product's peak value
+//! (setting `d/dt [e1·ln cos t + e2·ln cos(α − t)] = 0` gives `e1·sin t·cos(α − t) =
+//! e2·sin(α − t)·cos t`, and the product-to-sum identities turn both sides into
+//! `sin α ± sin(2t − α)`); the result axis `a_r` is that direction and `p` is the product's peak value
 //! `cos^e1(t*)·cos^e2(α − t*)`, so the result equals the product at its maximum.
 //!
 //! **Integral (table).** The exponent is chosen so that the result integrates to the

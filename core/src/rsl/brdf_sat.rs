@@ -36,7 +36,7 @@
 //! GGX `α = 0.01`) are integrated rather than point-sampled. Table sums are therefore
 //! integrals, not sample sums.
 //!
-//! **Resolution for a target error** ("model only what a scene needs", DESIGN.md):
+//! **Resolution for a target error** ("model only what a scene needs"):
 //! [`BrdfSat::for_target`] / [`BrdfSat::fit`] build tables of increasing grid size `n` and
 //! view count until the error against a reference integral (adaptive Gauss–Legendre
 //! quadrature of the same BRDF, `f64` accumulation, to 1 % of the target) on a test set of

@@ -74,6 +74,15 @@
 //!
 //! [`Rsl::new`] validates and returns [`Error`]. The projections never panic: NaN in any
 //! component gives NaN out; a zero local direction maps to the pole.
+//!
+//! # References
+//!
+//! - K. Xu, Y.-T. Jia, S.-M. Hu, C.-L. Tai, "All-frequency environment light rendering
+//!   using rotatable square light and multiple product approximation", 2006 (the text
+//!   this folder implements; no DOI is known to us). Section, figure and equation numbers
+//!   in this folder are its.
+//! - F. C. Crow, "Summed-area tables for texture mapping", *SIGGRAPH '84 Proceedings*
+//!   (Computer Graphics 18(3)), pp. 207–212, 1984 (the summed-area table, [`sat`]).
 
 #[cfg(feature = "alloc")]
 pub mod brdf_sat;

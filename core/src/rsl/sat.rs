@@ -201,8 +201,11 @@ pub struct SatView<'a> {
     sums: &'a [i64],
 }
 
-/// The sixteen entries a query reads, as the nine exact sub-box sums (in quanta), and the
-/// four corner fractions: the part of the query shared with the SIMD and GPU kernels.
+/// What a fractional-corner query reads, as the nine exact sub-box sums (in quanta, from at
+/// most sixteen entries) and the four corner fractions: the first half of the scalar query
+/// ([`SatView::terms`]), whose second half is [`BoxTerms::combine`]. The SIMD kernel reads
+/// the same nine sums per lane ([`SatView::integer_terms`]) and combines them with the same
+/// operations lane-wise; the WGSL kernel (`sat_lib.wgsl`) mirrors both.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct BoxTerms {
     /// `[P, E1, E0]` for the row pairs `(J0, J1)`, `(J1, J1+1)`, `(J0, J0+1)`.
@@ -441,7 +444,7 @@ impl<'a> SatView<'a> {
     }
 
     /// The nine exact sub-box sums and the corner fractions of a query, `None` if a corner
-    /// is NaN (the shared first half of the scalar, SIMD and GPU kernels).
+    /// is NaN (the first half of [`SatView::box_sum`]).
     #[inline(always)]
     pub fn terms(&self, u0: f32, v0: f32, u1: f32, v1: f32) -> Option<BoxTerms> {
         if u0.is_nan() || v0.is_nan() || u1.is_nan() || v1.is_nan() {

@@ -2,6 +2,10 @@
 //! integrals, the cap → lobe exponent optimum ([`cap`]), the exact product integral of two
 //! lobes ([`product`]), the triple-product rendering integral ([`triple`]) and the BRDF
 //! models ([`brdf`]).
+//!
+//! # References
+//!
+//! Those of `steradian_core::lobe`, whose kernels these references check (the cosine-lobe paper).
 
 pub mod brdf;
 pub mod cap;

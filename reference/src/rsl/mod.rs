@@ -2,6 +2,10 @@
 //! equal-area hemisphere map, box integrals of a texel grid ([`sat`]), signed distances to a
 //! visibility boundary and exact clipped coverage ([`vdt`]), and the coverage moments of a
 //! query square ([`moments`]).
+//!
+//! # References
+//!
+//! Those of `steradian_core::rsl`, whose kernels these references check (the rotatable-square-lights paper).
 
 pub mod moments;
 pub mod sat;

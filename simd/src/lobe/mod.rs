@@ -23,6 +23,10 @@
 //! The bound is the natural one for `exp(y)`: an error `δ` relative in `y = e·log1p(−t)`
 //! becomes `δ·|y| = δ·|ln(c/s)|` relative in the result. It is checked by the tests of this
 //! crate against the scalar kernel on pseudo-random and special inputs.
+//!
+//! # References
+//!
+//! Those of `steradian_core::lobe` (the cosine-lobe paper).
 
 use core::f32::consts::TAU;
 
