@@ -232,30 +232,33 @@ fn survey(fit: ProductFit, n: usize, seed: u64) -> Diff {
     worst
 }
 
-/// The bounds hold on pseudo-random lobes over the whole domain; prints the measured maxima
-/// (the values quoted at the constants).
+/// The largest measured difference per unit of the bound's shape that the module docs of
+/// `steradian_simd::lobe::product` quote as "at most": a quarter of the tolerance constants
+/// (`2e-6`). Measured on the development machine (2·10⁶ lanes per fit): scale 5.3e-7,
+/// exponent 6.3e-7, integral 6.3e-7; the margin covers other machines' `exp`/`ln` rounding.
+const SURVEY_MAX: f64 = 8.0e-7;
+
+/// The survey of the module docs (2·10⁶ pseudo-random lanes per fit over the whole domain):
+/// every maximum within [`SURVEY_MAX`], which the docs quote, and printed
+/// (`cargo test --release -p steradian-simd --test main survey -- --nocapture`).
 #[test]
 fn survey_max_differences() {
-    for (i, fit) in FITS.into_iter().enumerate() {
-        let w = survey(fit, 200_000, 0x5eed_0000 + i as u64);
-        println!(
-            "{fit:?}: max scale {:.2e}/(1+L), exponent {:.2e}/((1+L)(1+e)), integral {:.2e}/(1+L) ({:.2e} relative where |ln I| < 20)",
-            w.scale, w.exponent, w.integral, w.integral_raw
-        );
-    }
-}
-
-/// The long survey of the constants' docs (2·10⁶ lanes per fit):
-/// `cargo test --release -p steradian-simd --test product -- --ignored --nocapture`.
-#[test]
-#[ignore]
-fn survey_max_differences_long() {
     for (i, fit) in FITS.into_iter().enumerate() {
         let w = survey(fit, 2_000_000, 0x1_5eed_0000 + i as u64);
         println!(
             "{fit:?}: max scale {:.2e}/(1+L), exponent {:.2e}/((1+L)(1+e)), integral {:.2e}/(1+L) ({:.2e} relative where |ln I| < 20)",
             w.scale, w.exponent, w.integral, w.integral_raw
         );
+        for (what, v) in [
+            ("scale", w.scale),
+            ("exponent", w.exponent),
+            ("integral", w.integral),
+        ] {
+            assert!(
+                v <= SURVEY_MAX,
+                "{fit:?}: {what} {v:.2e} > {SURVEY_MAX:.1e}"
+            );
+        }
     }
 }
 
