@@ -1,69 +1,95 @@
-//! The kernels every backend runs, and their batch layout.
+//! The batch kernels every backend runs ([`Batch`], [`Kernel`]), and their batch layout.
 //!
 //! A batch is structure-of-arrays: [`Columns`] holds `arity` columns of `n` `f32` each,
 //! column `c` at `data[c·n .. (c+1)·n]`. The same layout is uploaded to the GPU.
 
 use std::fmt;
 
-/// A kernel of the library, as named in `steradian eval` and `report.json`.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
-pub enum Kernel {
-    /// Equal-area hemisphere map: `[x, y, z] → [u, v]`.
-    HemisphereMap,
-    /// Its inverse: `[u, v] → [x, y, z]`.
-    HemisphereUnmap,
-    /// Cosine lobe evaluation: `[ax, ay, az, s, e, vx, vy, vz] → [value]`.
-    LobeEval,
-    /// Exact lobe integral: `[e, s] → [integral]`.
-    LobeIntegral,
-    /// Cap → lobe L2 exponent from the table: `[half_angle] → [exponent]`.
-    CapExponent,
+use crate::rng::Rng;
+
+/// Everything the backends, the workload and the accuracy check need of one batch kernel
+/// (the kernels every backend runs over [`Columns`]). One per kernel, written beside its
+/// paper's other batch kernels (`batch/lobe.rs`, `batch/rsl.rs`) and registered once in
+/// [`crate::registry::KERNELS`]; nothing else matches on a kernel.
+pub struct Batch {
+    /// Name in `steradian eval` and `report.json`.
+    pub name: &'static str,
+    /// Input columns.
+    pub inputs: usize,
+    /// Output columns.
+    pub outputs: usize,
+    /// Salt of the workload's generator (kept per kernel so each kernel's default workload
+    /// is the same bytes from run to run and release to release).
+    pub seed: u64,
+    /// The scalar kernel over columns; `opaque` routes every value through
+    /// [`std::hint::black_box`] (the `cpu-scalar` backend: one call per row, no
+    /// auto-vectorisation), otherwise the compiler may vectorise the loop
+    /// (`cpu-scalar-loop`).
+    pub scalar: fn(&Columns, &mut Columns, bool),
+    /// The SIMD slice kernel of `steradian-simd` over columns.
+    pub simd: fn(&Columns, &mut Columns),
+    /// Whether the WGSL kernel (the registry entry's `wgsl`) reads the built-in cap-exponent
+    /// table at binding 3.
+    pub cap_table: bool,
+    /// Named hard cases, one row each.
+    pub hard_cases: fn() -> Vec<(&'static str, Vec<f32>)>,
+    /// One pseudo-random row over the kernel's whole domain.
+    pub random_row: fn(&mut Rng) -> Vec<f32>,
+    /// The f64 reference of one input row (the values [`Batch::error`] compares with).
+    pub reference: fn(&[f32]) -> Vec<f64>,
+    /// The error of one output row in the kernel's metric, from the input row, the output
+    /// (widened) and the reference values.
+    pub error: fn(&[f32], &[f64], &[f64]) -> f64,
 }
 
-impl Kernel {
-    /// Every kernel, in report order.
-    pub const ALL: [Kernel; 5] = [
-        Kernel::HemisphereMap,
-        Kernel::HemisphereUnmap,
-        Kernel::LobeEval,
-        Kernel::LobeIntegral,
-        Kernel::CapExponent,
-    ];
+/// `x`, through [`std::hint::black_box`] when `opaque` (see [`Batch::scalar`]).
+#[inline(always)]
+pub fn bb<T>(x: T, opaque: bool) -> T {
+    if opaque { std::hint::black_box(x) } else { x }
+}
 
+/// A batch kernel of the library: a handle to its [`Batch`], compared by name.
+#[derive(Clone, Copy)]
+pub struct Kernel(pub &'static Batch);
+
+impl Kernel {
     /// The kernel's name (`hemisphere-map`, …).
     pub const fn name(self) -> &'static str {
-        match self {
-            Kernel::HemisphereMap => "hemisphere-map",
-            Kernel::HemisphereUnmap => "hemisphere-unmap",
-            Kernel::LobeEval => "lobe-eval",
-            Kernel::LobeIntegral => "lobe-integral",
-            Kernel::CapExponent => "cap-exponent",
-        }
+        self.0.name
     }
 
-    /// Looks a kernel up by name.
-    pub fn from_name(name: &str) -> Option<Kernel> {
-        Kernel::ALL.into_iter().find(|k| k.name() == name)
+    /// The kernel's description.
+    pub const fn spec(self) -> &'static Batch {
+        self.0
     }
 
     /// Number of input columns.
     pub fn input_arity(self) -> usize {
-        match self {
-            Kernel::HemisphereMap => 3,
-            Kernel::HemisphereUnmap => 2,
-            Kernel::LobeEval => 8,
-            Kernel::LobeIntegral => 2,
-            Kernel::CapExponent => 1,
-        }
+        self.0.inputs
     }
 
     /// Number of output columns.
     pub fn output_arity(self) -> usize {
-        match self {
-            Kernel::HemisphereMap => 2,
-            Kernel::HemisphereUnmap => 3,
-            _ => 1,
-        }
+        self.0.outputs
+    }
+}
+
+impl PartialEq for Kernel {
+    fn eq(&self, other: &Kernel) -> bool {
+        self.name() == other.name()
+    }
+}
+impl Eq for Kernel {}
+
+impl std::hash::Hash for Kernel {
+    fn hash<H: std::hash::Hasher>(&self, h: &mut H) {
+        self.name().hash(h);
+    }
+}
+
+impl fmt::Debug for Kernel {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "Kernel({})", self.name())
     }
 }
 

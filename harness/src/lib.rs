@@ -6,6 +6,7 @@
 
 pub mod accuracy;
 pub mod backend;
+pub mod batch;
 pub mod env;
 pub mod eval;
 pub mod generate;

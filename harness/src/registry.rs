@@ -11,6 +11,7 @@
 use serde_json::{Map, Value};
 use steradian_core::wgsl;
 
+use crate::batch;
 use crate::kernels::Kernel;
 use crate::{handlers, product, sat, vdt};
 
@@ -121,7 +122,7 @@ const SHADE_BOUND: Bound = Bound {
 /// Every kernel, in report order.
 pub const KERNELS: &[KernelSpec] = &[
     KernelSpec {
-        name: Kernel::HemisphereMap.name(),
+        name: batch::rsl::HEMISPHERE_MAP.name(),
         paper: Paper::Rsl,
         contract: r#"{"dir": [x,y,z] with z ≥ 0, any non-zero length} -> {"p": [u,v]}"#,
         eval: Piece::At(handlers::hemisphere_map),
@@ -138,11 +139,11 @@ pub const KERNELS: &[KernelSpec] = &[
             item: "steradian_core::rsl::hemisphere::MAP_ABS_ERROR",
             value: Some(steradian_core::rsl::hemisphere::MAP_ABS_ERROR as f64),
         }),
-        batch: Some(Kernel::HemisphereMap),
+        batch: Some(batch::rsl::HEMISPHERE_MAP),
         tables: &[],
     },
     KernelSpec {
-        name: Kernel::HemisphereUnmap.name(),
+        name: batch::rsl::HEMISPHERE_UNMAP.name(),
         paper: Paper::Rsl,
         contract: r#"{"p": [u,v] with u²+v² ≤ 1} -> {"dir": [x,y,z]}"#,
         eval: Piece::At(handlers::hemisphere_unmap),
@@ -159,11 +160,11 @@ pub const KERNELS: &[KernelSpec] = &[
             item: "steradian_core::rsl::hemisphere::UNMAP_ABS_ERROR",
             value: Some(steradian_core::rsl::hemisphere::UNMAP_ABS_ERROR as f64),
         }),
-        batch: Some(Kernel::HemisphereUnmap),
+        batch: Some(batch::rsl::HEMISPHERE_UNMAP),
         tables: &[],
     },
     KernelSpec {
-        name: Kernel::LobeEval.name(),
+        name: batch::lobe::LOBE_EVAL.name(),
         paper: Paper::Lobe,
         contract: r#"{"axis": [x,y,z], "exponent": e, "scale": s (default 1), "dir": [x,y,z]} -> {"value": s·max(a·v,0)^e}"#,
         eval: Piece::At(handlers::lobe_eval),
@@ -180,11 +181,11 @@ pub const KERNELS: &[KernelSpec] = &[
             item: "steradian_core::lobe::EVAL_REL_ERROR",
             value: Some(steradian_core::lobe::EVAL_REL_ERROR as f64),
         }),
-        batch: Some(Kernel::LobeEval),
+        batch: Some(batch::lobe::LOBE_EVAL),
         tables: &[],
     },
     KernelSpec {
-        name: Kernel::LobeIntegral.name(),
+        name: batch::lobe::LOBE_INTEGRAL.name(),
         paper: Paper::Lobe,
         contract: r#"{"exponent": e, "scale": s (default 1)} -> {"integral": 2πs/(e+1)}"#,
         eval: Piece::At(handlers::lobe_integral),
@@ -201,11 +202,11 @@ pub const KERNELS: &[KernelSpec] = &[
             item: "steradian_core::lobe::INTEGRAL_REL_ERROR",
             value: Some(steradian_core::lobe::INTEGRAL_REL_ERROR as f64),
         }),
-        batch: Some(Kernel::LobeIntegral),
+        batch: Some(batch::lobe::LOBE_INTEGRAL),
         tables: &[],
     },
     KernelSpec {
-        name: Kernel::CapExponent.name(),
+        name: batch::lobe::CAP_EXPONENT.name(),
         paper: Paper::Lobe,
         contract: r#"{"half_angle": α in [1e-18, π/2]} -> {"exponent": e} (L2 fit, from the table)"#,
         eval: Piece::At(handlers::cap_exponent),
@@ -222,7 +223,7 @@ pub const KERNELS: &[KernelSpec] = &[
             item: "steradian_core::lobe::cap::EXCESS_L2_REL",
             value: Some(steradian_core::lobe::cap::EXCESS_L2_REL),
         }),
-        batch: Some(Kernel::CapExponent),
+        batch: Some(batch::lobe::CAP_EXPONENT),
         tables: &["cap_exponent.bin"],
     },
     KernelSpec {
@@ -350,7 +351,7 @@ pub fn of(kernel: Kernel) -> &'static KernelSpec {
 }
 
 /// The batch kernels, in report order.
-pub fn batch_kernels() -> impl Iterator<Item = Kernel> {
+pub fn batch_kernels() -> impl Iterator<Item = Kernel> + Clone {
     KERNELS.iter().filter_map(|k| k.batch)
 }
 
@@ -452,10 +453,15 @@ pub fn missing_pieces(kernels: &[KernelSpec], root: &std::path::Path) -> Missing
             out.push((name, "WGSL kernel without a registry entry".into()));
         }
     }
-    for b in Kernel::ALL {
-        let n = kernels.iter().filter(|k| k.batch == Some(b)).count();
-        if n != 1 {
-            out.push((b.name(), format!("batch kernel registered {n} times")));
+    for k in kernels {
+        if let Some(b) = k.batch {
+            if b.name() != k.name {
+                out.push((k.name, format!("batch kernel named `{}`", b.name())));
+            }
+            let n = kernels.iter().filter(|o| o.batch == Some(b)).count();
+            if n != 1 {
+                out.push((k.name, format!("batch kernel registered {n} times")));
+            }
         }
     }
     out

@@ -11,6 +11,7 @@ use std::time::Instant;
 use steradian_core::wgsl;
 use steradian_harness::backend::gpu::Gpu;
 use steradian_harness::backend::{Backend, cpu};
+use steradian_harness::batch;
 use steradian_harness::kernels::{Columns, Kernel};
 
 use core::f32::consts::{FRAC_PI_2, PI};
@@ -128,10 +129,10 @@ fn allowed(kernel: Kernel, input: &Columns, row: usize, c: f32) -> Allowed {
         unit: 1.0,
         flushed: false,
     };
-    match kernel {
-        Kernel::HemisphereMap => abs(wgsl::HEMISPHERE_MAP_ABS_TOL),
-        Kernel::HemisphereUnmap => abs(wgsl::HEMISPHERE_UNMAP_ABS_TOL),
-        Kernel::LobeEval => {
+    match kernel.name() {
+        "hemisphere-map" => abs(wgsl::HEMISPHERE_MAP_ABS_TOL),
+        "hemisphere-unmap" => abs(wgsl::HEMISPHERE_UNMAP_ABS_TOL),
+        "lobe-eval" => {
             let s = input.data[3 * input.n + row] as f64;
             let floor = s.abs() * min_normal;
             if c64.abs() <= floor {
@@ -149,7 +150,7 @@ fn allowed(kernel: Kernel, input: &Columns, row: usize, c: f32) -> Allowed {
                 }
             }
         }
-        Kernel::LobeIntegral => {
+        "lobe-integral" => {
             if c64.abs() < min_normal {
                 Allowed {
                     tol: min_normal,
@@ -166,11 +167,12 @@ fn allowed(kernel: Kernel, input: &Columns, row: usize, c: f32) -> Allowed {
                 }
             }
         }
-        Kernel::CapExponent => Allowed {
+        "cap-exponent" => Allowed {
             tol: wgsl::CAP_EXPONENT_REL_TOL as f64 * c64.abs() + wgsl::CAP_EXPONENT_ABS_TOL as f64,
             unit: c64.abs(),
             flushed: false,
         },
+        other => panic!("{other}: no GPU tolerance in this test"),
     }
 }
 
@@ -413,12 +415,13 @@ fn cap_inputs(rng: &mut Rng) -> Columns {
 
 fn inputs(kernel: Kernel, seed: u64) -> Columns {
     let mut rng = Rng(steradian_harness::rng::Rng::new(seed));
-    match kernel {
-        Kernel::HemisphereMap => map_inputs(&mut rng),
-        Kernel::HemisphereUnmap => unmap_inputs(&mut rng),
-        Kernel::LobeEval => lobe_eval_inputs(&mut rng),
-        Kernel::LobeIntegral => lobe_integral_inputs(&mut rng),
-        Kernel::CapExponent => cap_inputs(&mut rng),
+    match kernel.name() {
+        "hemisphere-map" => map_inputs(&mut rng),
+        "hemisphere-unmap" => unmap_inputs(&mut rng),
+        "lobe-eval" => lobe_eval_inputs(&mut rng),
+        "lobe-integral" => lobe_integral_inputs(&mut rng),
+        "cap-exponent" => cap_inputs(&mut rng),
+        other => panic!("{other}: no GPU inputs in this test"),
     }
 }
 
@@ -426,7 +429,7 @@ fn inputs(kernel: Kernel, seed: u64) -> Columns {
 fn kernels_match_scalar_within_documented_tolerance() {
     let Some(mut gpu) = gpu() else { return };
     for kernel in steradian_harness::registry::batch_kernels() {
-        let input = inputs(kernel, 0x5EED ^ kernel as u64);
+        let input = inputs(kernel, 0x5EED ^ kernel.spec().seed);
         let stats = check(&mut gpu, kernel, &input);
         eprintln!(
             "{kernel:>16}: {} rows ({} in the flush-to-zero range), max |diff| {:.3e}, \
@@ -466,7 +469,7 @@ fn tiny_batches_and_reuse() {
     // shape errors are errors, not panics
     let bad = Columns::zeros(2, 4);
     let mut out = Columns::zeros(1, 4);
-    assert!(gpu.run(Kernel::LobeEval, &bad, &mut out).is_err());
+    assert!(gpu.run(batch::lobe::LOBE_EVAL, &bad, &mut out).is_err());
 }
 
 #[test]
@@ -480,15 +483,15 @@ fn large_batches_fold_into_2d_and_split_into_chunks() {
         input.data[r] = rng.range(-1.0, 1000.0);
         input.data[n + r] = rng.range(-10.0, 10.0);
     }
-    let stats = check(&mut gpu, Kernel::LobeIntegral, &input);
+    let stats = check(&mut gpu, batch::lobe::LOBE_INTEGRAL, &input);
     eprintln!(
         "lobe-integral, 5M rows in one chunk: max ulps {}",
         stats.max_ulps
     );
     // The same batch in chunks of an odd number of rows (not a multiple of 64).
     gpu.set_max_chunk_rows(Some(1_234_567));
-    assert_eq!(gpu.chunk_rows(Kernel::LobeIntegral), 1_234_567);
-    let stats = check(&mut gpu, Kernel::LobeIntegral, &input);
+    assert_eq!(gpu.chunk_rows(batch::lobe::LOBE_INTEGRAL), 1_234_567);
+    let stats = check(&mut gpu, batch::lobe::LOBE_INTEGRAL, &input);
     eprintln!(
         "lobe-integral, 5M rows in chunks: max ulps {}",
         stats.max_ulps
@@ -496,9 +499,9 @@ fn large_batches_fold_into_2d_and_split_into_chunks() {
     // Chunked multi-column kernels: columns are gathered per chunk.
     gpu.set_max_chunk_rows(Some(777));
     for kernel in [
-        Kernel::LobeEval,
-        Kernel::HemisphereMap,
-        Kernel::HemisphereUnmap,
+        batch::lobe::LOBE_EVAL,
+        batch::rsl::HEMISPHERE_MAP,
+        batch::rsl::HEMISPHERE_UNMAP,
     ] {
         check(&mut gpu, kernel, &inputs(kernel, 3));
     }

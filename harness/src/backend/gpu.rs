@@ -20,8 +20,6 @@ use std::collections::HashMap;
 use std::num::NonZeroU64;
 use std::sync::{Arc, Mutex, mpsc};
 
-use steradian_core::wgsl;
-
 use super::{Backend, BackendError, check_shapes};
 use crate::kernels::{Columns, Kernel};
 
@@ -145,15 +143,6 @@ fn uniform_entry(binding: u32) -> wgpu::BindGroupLayoutEntry {
         },
         count: None,
     }
-}
-
-/// The WGSL source of a kernel, by its name in [`wgsl::ALL`].
-fn source(kernel: Kernel) -> Result<&'static str, BackendError> {
-    wgsl::ALL
-        .iter()
-        .find(|(name, _)| *name == kernel.name())
-        .map(|(_, src)| *src)
-        .ok_or_else(|| BackendError(format!("{kernel}: no WGSL source")))
 }
 
 /// Runs `f` inside validation and out-of-memory error scopes; an error caught by either is
@@ -647,10 +636,14 @@ impl Backend for Gpu {
         check_shapes(kernel, input, out)?;
         let job = Job {
             label: kernel.name(),
-            source: source(kernel)?,
+            source: crate::registry::of(kernel)
+                .wgsl
+                .get()
+                .map(|w| w.source)
+                .ok_or_else(|| BackendError(format!("{kernel}: no WGSL source")))?,
             input_arity: kernel.input_arity(),
             output_arity: kernel.output_arity(),
-            table: (kernel == Kernel::CapExponent).then_some(TableSource::CapExponent),
+            table: kernel.spec().cap_table.then_some(TableSource::CapExponent),
         };
         self.run_job(&job, input, out)
     }
