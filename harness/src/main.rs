@@ -24,10 +24,14 @@ enum Command {
         /// Output directory.
         #[arg(long, default_value = "report")]
         out: PathBuf,
-        /// Inputs per kernel for the throughput runs.
+        /// Size of the throughput workloads: inputs per kernel of the top table; every
+        /// section's throughput workload (queries, products, … per timed run) is scaled by
+        /// n / 2^20 (at least 1). The sections' error samples do not change with it; the top
+        /// table's errors are over its first min(n, error-rows) inputs.
         #[arg(long, default_value_t = 1 << 20)]
         n: usize,
-        /// Timed repeats per kernel and backend (the median is reported).
+        /// Timed runs of every throughput measurement, top table and sections alike, after
+        /// one untimed warm-up run (the median is reported).
         #[arg(long, default_value_t = 7)]
         repeats: usize,
         /// Rows compared against the f64 reference (hard cases first).

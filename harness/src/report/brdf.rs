@@ -8,16 +8,16 @@
 use std::error::Error;
 use std::fmt::Write as _;
 use std::hint::black_box;
-use std::time::{Duration, Instant};
 
 use indicatif::{ProgressBar, ProgressStyle};
 use serde_json::json;
 use steradian_core::lobe::brdf::{BlinnPhong, Brdf, Ggx, Lambert, Phong, Ward};
-use steradian_core::rsl::brdf_sat::{BrdfSat, FitOptions};
+use steradian_core::rsl::brdf_sat::{BrdfSat, Fit, FitOptions, Resolution};
 use steradian_core::{Vec2, Vec3, rsl::hemisphere};
 
 use super::Options;
 use super::section::Section;
+use super::timing::{median_time, per_second, timed};
 use crate::reference::AsModel;
 use crate::reference::brdf::{self as rb, Model};
 use crate::rng::Rng;
@@ -34,12 +34,12 @@ pub const THETA_MAX_DEG: f32 = 80.0;
 pub const ANISO_THETA_MAX_DEG: f32 = 60.0;
 /// Cap on each model's tables.
 pub const MAX_BYTES: usize = 16 << 20;
-/// Queries per timed run.
+/// Queries per timed run at the default `--n` ([`Options::scaled`]).
 const QUERIES: usize = 1 << 14;
 /// Fresh queries compared against the f64 reference per model.
 const CHECKED: usize = 60;
-/// Timed repeats (median).
-const REPEATS: usize = 5;
+/// Seed of the queries.
+const QUERY_SEED: u64 = 0x00b5_d5a7;
 
 /// One BRDF-SAT query.
 #[derive(Clone, Copy, Debug)]
@@ -118,22 +118,6 @@ pub fn gl4_square(b: &dyn Brdf, wo: Vec3, c: Vec2, r: f32, turn: bool) -> f32 {
     2.0 * s * h * h
 }
 
-fn median(mut v: Vec<Duration>) -> Duration {
-    v.sort();
-    v[v.len() / 2]
-}
-
-fn time<F: FnMut() -> f32>(mut f: F) -> Duration {
-    let t: Vec<Duration> = (0..REPEATS)
-        .map(|_| {
-            let t0 = Instant::now();
-            black_box(f());
-            t0.elapsed()
-        })
-        .collect();
-    median(t)
-}
-
 /// The models of the section.
 pub fn models() -> Vec<(String, Box<dyn Brdf>, Model)> {
     fn m<B: Brdf + Copy + AsModel + 'static>(name: &str, b: B) -> (String, Box<dyn Brdf>, Model) {
@@ -160,8 +144,87 @@ pub fn models() -> Vec<(String, Box<dyn Brdf>, Model)> {
     ]
 }
 
-/// The section.
-pub fn section(_opts: &Options) -> Result<Section, Box<dyn Error>> {
+/// One model's tables: what the fit chose and achieved, the errors on fresh queries, the
+/// times.
+#[derive(Clone, Debug)]
+pub struct ModelResult {
+    /// Model name.
+    pub name: String,
+    /// Whether the BRDF is isotropic.
+    pub isotropic: bool,
+    /// Largest view angle tabulated (degrees).
+    pub theta_max_deg: f32,
+    /// The resolution the fit chose.
+    pub resolution: Resolution,
+    /// Bytes of the tables.
+    pub bytes: usize,
+    /// The fit's own report.
+    pub fit: Fit,
+    /// Largest table error on the fresh queries.
+    pub fresh_max: f64,
+    /// RMS table error on the fresh queries.
+    pub fresh_rms: f64,
+    /// Largest 4×4 Gauss–Legendre error on the same queries.
+    pub gl_max: f64,
+    /// Its RMS.
+    pub gl_rms: f64,
+    /// Seconds the fit took.
+    pub fit_seconds: f64,
+    /// Table queries per second.
+    pub queries_per_s: f64,
+    /// 4×4 Gauss–Legendre queries per second.
+    pub gl_queries_per_s: f64,
+}
+
+/// Everything the section measures.
+#[derive(Clone, Debug)]
+pub struct BrdfResults {
+    /// Queries per timed run.
+    pub queries: usize,
+    /// Timed repeats.
+    pub repeats: usize,
+    /// One entry per model.
+    pub models: Vec<ModelResult>,
+}
+
+/// Largest and RMS error of the table `t` and of the 4×4 Gauss–Legendre baseline on `qs`
+/// against the f64 reference: `(table max, table rms, GL max, GL rms)`.
+fn fresh_errors(b: &dyn Brdf, model: &Model, t: &BrdfSat, qs: &[Query]) -> (f64, f64, f64, f64) {
+    let (mut e_tab, mut e_gl, mut s_tab, mut s_gl) = (0.0f64, 0.0f64, 0.0f64, 0.0f64);
+    let (mut last_wo, mut albedo) = (Vec3::NAN, 0.0);
+    for x in qs {
+        let wo = [x.wo.x as f64, x.wo.y as f64, x.wo.z as f64];
+        if x.wo != last_wo {
+            albedo = rb::albedo(model, wo, 1e-5);
+            last_wo = x.wo;
+        }
+        let pm = rb::map(wo);
+        let angle = if b.is_isotropic() {
+            pm[1].atan2(pm[0])
+        } else {
+            0.0
+        };
+        let r = x.r as f64;
+        let c = [x.centre.x as f64, x.centre.y as f64];
+        let exact = rb::square_integral(model, wo, c, r, angle, 1e-4 * albedo * r * r);
+        let et = rb::table_error(t.integral(x.wo, x.centre, x.r) as f64, exact, albedo, r);
+        let eg = rb::table_error(
+            gl4_square(b, x.wo, x.centre, x.r, b.is_isotropic()) as f64,
+            exact,
+            albedo,
+            r,
+        );
+        e_tab = e_tab.max(et);
+        e_gl = e_gl.max(eg);
+        s_tab += et * et;
+        s_gl += eg * eg;
+    }
+    let n = qs.len() as f64;
+    (e_tab, (s_tab / n).sqrt(), e_gl, (s_gl / n).sqrt())
+}
+
+/// Runs the section's measurements.
+pub fn measure(opts: &Options) -> Result<BrdfResults, Box<dyn Error>> {
     let models = models();
     let bar = ProgressBar::new(models.len() as u64).with_style(
         ProgressStyle::with_template("{spinner} [{elapsed_precise}] {bar:30} {pos}/{len} {msg}")
@@ -184,167 +247,191 @@ pub fn section(_opts: &Options) -> Result<Section, Box<dyn Error>> {
         theta_max: ANISO_THETA_MAX_DEG.to_radians(),
         ..iso_opts
     };
+    let n_timed = opts.scaled(QUERIES);
     let mut rows = Vec::new();
     for (name, b, model) in &models {
         bar.set_message(name.clone());
-        let t0 = Instant::now();
-        let opts = if b.is_isotropic() {
+        let fo = if b.is_isotropic() {
             &iso_opts
         } else {
             &aniso_opts
         };
-        let t = BrdfSat::fit(b.as_ref(), opts)?;
-        let fit_time = t0.elapsed();
-        let q = queries(QUERIES, R_MIN, R_MAX, opts.theta_max, 0x00b5_d5a7);
+        let (t, fit_time) = timed(|| BrdfSat::fit(b.as_ref(), fo));
+        let t = t?;
         let fit = t
             .fit_report()
             .ok_or("BrdfSat::fit returned no fit report")?;
-        // fresh queries against the f64 reference: table and baseline errors
-        let (mut e_tab, mut e_gl, mut s_tab, mut s_gl) = (0.0f64, 0.0f64, 0.0f64, 0.0f64);
-        let (mut last_wo, mut albedo) = (Vec3::NAN, 0.0);
-        for x in q.iter().take(CHECKED) {
-            let wo = [x.wo.x as f64, x.wo.y as f64, x.wo.z as f64];
-            if x.wo != last_wo {
-                albedo = rb::albedo(model, wo, 1e-5);
-                last_wo = x.wo;
-            }
-            let pm = rb::map(wo);
-            let angle = if b.is_isotropic() {
-                pm[1].atan2(pm[0])
-            } else {
-                0.0
-            };
-            let r = x.r as f64;
-            let c = [x.centre.x as f64, x.centre.y as f64];
-            let exact = rb::square_integral(model, wo, c, r, angle, 1e-4 * albedo * r * r);
-            let et = rb::table_error(t.integral(x.wo, x.centre, x.r) as f64, exact, albedo, r);
-            let eg = rb::table_error(
-                gl4_square(b.as_ref(), x.wo, x.centre, x.r, b.is_isotropic()) as f64,
-                exact,
-                albedo,
-                r,
+        // Fresh queries against the f64 reference: table and baseline errors.
+        let checked = queries(CHECKED, R_MIN, R_MAX, fo.theta_max, QUERY_SEED);
+        let (fresh_max, fresh_rms, gl_max, gl_rms) = fresh_errors(b.as_ref(), model, &t, &checked);
+        let q = queries(n_timed, R_MIN, R_MAX, fo.theta_max, QUERY_SEED);
+        let t_tab = median_time(opts.repeats, || {
+            black_box(
+                q.iter()
+                    .map(|x| t.integral(x.wo, x.centre, x.r))
+                    .sum::<f32>(),
             );
-            e_tab = e_tab.max(et);
-            e_gl = e_gl.max(eg);
-            s_tab += et * et;
-            s_gl += eg * eg;
-        }
-        let n = CHECKED as f64;
-        let t_tab = time(|| q.iter().map(|x| t.integral(x.wo, x.centre, x.r)).sum());
-        let t_gl = time(|| {
-            q.iter()
-                .map(|x| gl4_square(b.as_ref(), x.wo, x.centre, x.r, b.is_isotropic()))
-                .sum()
         });
-        let res = t.resolution();
-        rows.push(json!({
-            "model": name,
-            "isotropic": b.is_isotropic(),
-            "theta_max_deg": opts.theta_max.to_degrees(),
-            "grid": res.grid,
-            "polar_views": res.polar,
-            "azimuth_views": res.azimuth,
-            "bytes": t.bytes(),
-            "target": fit.target,
-            "met": fit.met,
-            "fit_max_error": fit.max_error,
-            "fit_rms_error": fit.rms_error,
-            "fit_steps": fit.steps,
-            "fresh_max_error": e_tab,
-            "fresh_rms_error": (s_tab / n).sqrt(),
-            "gl4x4_max_error": e_gl,
-            "gl4x4_rms_error": (s_gl / n).sqrt(),
-            "fit_seconds": fit_time.as_secs_f64(),
-            "queries_per_s": QUERIES as f64 / t_tab.as_secs_f64(),
-            "gl4x4_queries_per_s": QUERIES as f64 / t_gl.as_secs_f64(),
-        }));
+        let t_gl = median_time(opts.repeats, || {
+            black_box(
+                q.iter()
+                    .map(|x| gl4_square(b.as_ref(), x.wo, x.centre, x.r, b.is_isotropic()))
+                    .sum::<f32>(),
+            );
+        });
+        rows.push(ModelResult {
+            name: name.clone(),
+            isotropic: b.is_isotropic(),
+            theta_max_deg: fo.theta_max.to_degrees(),
+            resolution: t.resolution(),
+            bytes: t.bytes(),
+            fit,
+            fresh_max,
+            fresh_rms,
+            gl_max,
+            gl_rms,
+            fit_seconds: fit_time.as_secs_f64(),
+            queries_per_s: per_second(n_timed, t_tab),
+            gl_queries_per_s: per_second(n_timed, t_gl),
+        });
         bar.inc(1);
     }
     bar.finish_and_clear();
+    Ok(BrdfResults {
+        queries: n_timed,
+        repeats: opts.repeats,
+        models: rows,
+    })
+}
 
-    let f = |r: &serde_json::Value, k: &str| r[k].as_f64().unwrap_or(f64::NAN);
+/// `""`, or `" (not met)"` when the fit missed its target.
+fn not_met(m: &ModelResult) -> &'static str {
+    if m.fit.met { "" } else { " (not met)" }
+}
+
+/// The summary text of the section.
+fn summary(r: &BrdfResults) -> String {
     let mut summary = format!(
         "BRDF SATs (target {TARGET}, squares r {R_MIN}–{R_MAX}, views ≤ {THETA_MAX_DEG}° \
          (anisotropic ≤ {ANISO_THETA_MAX_DEG}°), ≤ {} MiB per model; baseline: 4×4 Gauss–Legendre over the square, same run):\n",
         MAX_BYTES >> 20
     );
+    for m in &r.models {
+        let views = format!("{}×{}", m.resolution.polar, m.resolution.azimuth);
+        let _ = writeln!(
+            summary,
+            "  {:<22} grid {:>4} views {:>6} {:>7.2} MiB fit max {:.4}{} fresh max {:.4} \
+             (GL4×4 {:.4}) fit {:.2} s, {:.1} M q/s = {:.1}× GL4×4",
+            m.name,
+            m.resolution.grid,
+            views,
+            m.bytes as f64 / (1 << 20) as f64,
+            m.fit.max_error,
+            not_met(m),
+            m.fresh_max,
+            m.gl_max,
+            m.fit_seconds,
+            m.queries_per_s / 1e6,
+            m.queries_per_s / m.gl_queries_per_s
+        );
+    }
+    summary
+}
+
+/// The HTML of the section.
+fn html(r: &BrdfResults) -> String {
     let mut html = format!(
         "<p>Each model's tables are chosen by <code>BrdfSat::fit</code> for a target error of \
          {TARGET} (error = |T − R| / max(R, albedo·4r²/2π), see <code>brdf_sat</code>) on squares of \
          half-diagonal {R_MIN}–{R_MAX} (parametrisation units) and views up to {THETA_MAX_DEG}° (anisotropic: {ANISO_THETA_MAX_DEG}°), at most {} MiB of tables per model. \
          “fit” errors are over the fit's own test set, “fresh” over {CHECKED} other queries \
-         against the f64 reference. Throughput over {QUERIES} queries, median of {REPEATS}; \
+         against the f64 reference. Throughput over {} queries, median of {}; \
          the baseline is a 4×4 Gauss–Legendre quadrature of ρ·cos over the same square \
          (16 BRDF evaluations).</p><table><tr><th>model</th><th>grid</th><th>views</th>\
          <th>MiB</th><th>fit max / rms</th><th>fresh max / rms</th><th>GL 4×4 max / rms</th>\
          <th>fit s</th><th>M queries/s</th><th>× GL 4×4</th></tr>",
-        MAX_BYTES >> 20
+        MAX_BYTES >> 20,
+        r.queries,
+        r.repeats
     );
-    for r in &rows {
-        let views = format!(
-            "{}×{}",
-            r["polar_views"].as_u64().unwrap_or(0),
-            r["azimuth_views"].as_u64().unwrap_or(0)
-        );
-        let ratio = f(r, "queries_per_s") / f(r, "gl4x4_queries_per_s");
-        let _ = writeln!(
-            summary,
-            "  {:<22} grid {:>4} views {:>6} {:>7.2} MiB fit max {:.4}{} fresh max {:.4} \
-             (GL4×4 {:.4}) fit {:.2} s, {:.1} M q/s = {:.1}× GL4×4",
-            r["model"].as_str().unwrap_or(""),
-            r["grid"].as_u64().unwrap_or(0),
-            views,
-            f(r, "bytes") / (1 << 20) as f64,
-            f(r, "fit_max_error"),
-            if r["met"].as_bool() == Some(true) {
-                ""
-            } else {
-                " (not met)"
-            },
-            f(r, "fresh_max_error"),
-            f(r, "gl4x4_max_error"),
-            f(r, "fit_seconds"),
-            f(r, "queries_per_s") / 1e6,
-            ratio
-        );
+    for m in &r.models {
+        let views = format!("{}×{}", m.resolution.polar, m.resolution.azimuth);
         let _ = write!(
             html,
             "<tr><td>{}</td><td>{}</td><td>{views}</td><td>{:.2}</td><td>{:.4} / {:.4}{}</td>\
              <td>{:.4} / {:.4}</td><td>{:.4} / {:.4}</td><td>{:.2}</td><td>{:.1}</td><td>{:.1}</td></tr>",
-            r["model"].as_str().unwrap_or(""),
-            r["grid"].as_u64().unwrap_or(0),
-            f(r, "bytes") / (1 << 20) as f64,
-            f(r, "fit_max_error"),
-            f(r, "fit_rms_error"),
-            if r["met"].as_bool() == Some(true) {
-                ""
-            } else {
-                " (not met)"
-            },
-            f(r, "fresh_max_error"),
-            f(r, "fresh_rms_error"),
-            f(r, "gl4x4_max_error"),
-            f(r, "gl4x4_rms_error"),
-            f(r, "fit_seconds"),
-            f(r, "queries_per_s") / 1e6,
-            ratio
+            m.name,
+            m.resolution.grid,
+            m.bytes as f64 / (1 << 20) as f64,
+            m.fit.max_error,
+            m.fit.rms_error,
+            not_met(m),
+            m.fresh_max,
+            m.fresh_rms,
+            m.gl_max,
+            m.gl_rms,
+            m.fit_seconds,
+            m.queries_per_s / 1e6,
+            m.queries_per_s / m.gl_queries_per_s
         );
     }
     html.push_str("</table>");
-    Ok(Section {
+    html
+}
+
+/// The data of the section in `report.json`.
+fn data(r: &BrdfResults) -> serde_json::Value {
+    let models: Vec<_> = r
+        .models
+        .iter()
+        .map(|m| {
+            json!({
+                "model": m.name,
+                "isotropic": m.isotropic,
+                "theta_max_deg": m.theta_max_deg,
+                "grid": m.resolution.grid,
+                "polar_views": m.resolution.polar,
+                "azimuth_views": m.resolution.azimuth,
+                "bytes": m.bytes,
+                "target": m.fit.target,
+                "met": m.fit.met,
+                "fit_max_error": m.fit.max_error,
+                "fit_rms_error": m.fit.rms_error,
+                "fit_steps": m.fit.steps,
+                "fresh_max_error": m.fresh_max,
+                "fresh_rms_error": m.fresh_rms,
+                "gl4x4_max_error": m.gl_max,
+                "gl4x4_rms_error": m.gl_rms,
+                "fit_seconds": m.fit_seconds,
+                "queries_per_s": m.queries_per_s,
+                "gl4x4_queries_per_s": m.gl_queries_per_s,
+            })
+        })
+        .collect();
+    json!({
+        "target": TARGET,
+        "r_min": R_MIN,
+        "r_max": R_MAX,
+        "theta_max_deg": THETA_MAX_DEG,
+        "queries": r.queries,
+        "checked": CHECKED,
+        "models": models,
+    })
+}
+
+/// The section of measured results.
+pub fn render(r: &BrdfResults) -> Section {
+    Section {
         id: "brdf_sat",
         title: "BRDF summed-area tables".into(),
-        summary,
-        html,
-        data: json!({
-            "target": TARGET,
-            "r_min": R_MIN,
-            "r_max": R_MAX,
-            "theta_max_deg": THETA_MAX_DEG,
-            "queries": QUERIES,
-            "checked": CHECKED,
-            "models": rows,
-        }),
+        summary: summary(r),
+        html: html(r),
+        data: data(r),
         files: Vec::new(),
-    })
+    }
+}
+
+/// The section.
+pub fn section(opts: &Options) -> Result<Section, Box<dyn Error>> {
+    Ok(render(&measure(opts)?))
 }

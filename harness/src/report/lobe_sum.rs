@@ -14,7 +14,7 @@
 //! (every product computed) in the same run.
 
 use std::error::Error;
-use std::time::Instant;
+use std::hint::black_box;
 
 use indicatif::{ProgressBar, ProgressStyle};
 use serde_json::json;
@@ -27,8 +27,9 @@ use steradian_core::lobe::sum::{
 use steradian_core::lobe::{CosineLobe, Phong};
 
 use super::Options;
-use super::plot::{Pt, Scale, Series, chart};
+use super::plot::{Axis, Chart, Pt, Scale, Series};
 use super::section::Section;
+use super::timing::{median_time, ns_per, timed};
 use crate::reference as adapt;
 use crate::reference::triple::{self as reference, Scene, Term, Visibility};
 use crate::rng::Rng;
@@ -40,6 +41,8 @@ const GRID: (usize, usize) = (8, 5);
 const OCCLUDERS: usize = 32;
 /// Quadrature tolerance of the references.
 const REF_TOL: f64 = 1e-6;
+/// Passes over every point per timed run at the default `--n` ([`Options::scaled`]).
+const TIMED_PASSES: usize = 1;
 
 struct Point {
     r: [LobeSum<2>; 2],
@@ -171,16 +174,6 @@ fn build_points(bar: &ProgressBar) -> Result<Vec<Point>, Box<dyn Error>> {
     Ok(points)
 }
 
-struct Row {
-    curve: usize,
-    t: f64,
-    products: f64,
-    dropped: f64,
-    ns_per_point: f64,
-    err_max: f64,
-    err_mean: f64,
-}
-
 fn kernel(fit: ProductFit) -> impl Fn(&CosineLobe, &CosineLobe) -> CosineLobe {
     move |a, b| product::product_with(&ProductTable::builtin(), fit, a, b)
 }
@@ -197,19 +190,60 @@ fn run_curve(points: &[Point], ci: usize, t: f32) -> (Vec<f32>, ProductCounts) {
     (vals, counts)
 }
 
-/// The report section (see the module docs).
-pub fn section(_opts: &Options) -> Result<Section, Box<dyn Error>> {
+/// One point of a curve: a threshold, its products, time and error.
+#[derive(Clone, Debug)]
+pub struct Row {
+    /// Index into the curves (product fit and place of the cosine).
+    pub curve: usize,
+    /// Pruning threshold over the brightest unshadowed value.
+    pub t: f64,
+    /// Products computed per point.
+    pub products: f64,
+    /// Products dropped per point.
+    pub dropped: f64,
+    /// Median nanoseconds per point.
+    pub ns_per_point: f64,
+    /// Largest error over the brightest unshadowed value.
+    pub err_max: f64,
+    /// Mean error over the brightest unshadowed value.
+    pub err_mean: f64,
+}
+
+/// Everything the section measures.
+#[derive(Clone, Debug)]
+pub struct LobeSumResults {
+    /// Shaded points.
+    pub points: usize,
+    /// Smallest and largest half-angle of the light's cap over the points.
+    pub half_angles: (f32, f32),
+    /// The brightest unshadowed value of the scene (the error unit).
+    pub max_unshadowed: f64,
+    /// Seconds the f64 references took.
+    pub reference_seconds: f64,
+    /// Lobe model against the physical reference at `t = 0`: (max, mean) over max S.
+    pub model_error: (f64, f64),
+    /// Every curve at every threshold.
+    pub rows: Vec<Row>,
+}
+
+/// The curve's name.
+fn name(r: &Row) -> &'static str {
+    CURVES[r.curve].name
+}
+
+/// Runs the section's measurements.
+pub fn measure(opts: &Options) -> Result<LobeSumResults, Box<dyn Error>> {
     let n_points = (GRID.0 * GRID.1) as u64;
     let bar = ProgressBar::new(n_points + (CURVES.len() * THRESHOLDS.len()) as u64).with_style(
         ProgressStyle::with_template("{spinner} [{elapsed_precise}] {bar:30} {pos}/{len} {msg}")
             .unwrap_or_else(|_| ProgressStyle::default_bar()),
     );
     bar.set_message("lobe-sum: f64 references");
-    let t0 = Instant::now();
-    let points = build_points(&bar)?;
-    let ref_s = t0.elapsed().as_secs_f64();
+    let (points, ref_time) = timed(|| build_points(&bar));
+    let points = points?;
     let scale = points.iter().map(|p| p.unshadowed).fold(0.0, f64::max);
     bar.set_message("lobe-sum: chains");
+    let passes = opts.scaled(TIMED_PASSES);
     let mut rows = Vec::new();
     let mut model_err = (0.0f64, 0.0f64);
     for (ci, _) in CURVES.iter().enumerate() {
@@ -228,22 +262,17 @@ pub fn section(_opts: &Options) -> Result<Section, Box<dyn Error>> {
                     model_err.1 += e / points.len() as f64;
                 }
             }
-            // Time: median of 5 runs over every point.
-            let mut times: Vec<f64> = (0..5)
-                .map(|_| {
-                    let s = Instant::now();
-                    let (v, _) = run_curve(&points, ci, t);
-                    std::hint::black_box(v);
-                    s.elapsed().as_secs_f64()
-                })
-                .collect();
-            times.sort_by(f64::total_cmp);
+            let d = median_time(opts.repeats, || {
+                for _ in 0..passes {
+                    black_box(run_curve(&points, ci, t));
+                }
+            });
             rows.push(Row {
                 curve: ci,
                 t: k,
                 products: counts.computed as f64 / points.len() as f64,
                 dropped: counts.dropped() as f64 / points.len() as f64,
-                ns_per_point: times[2] * 1e9 / points.len() as f64,
+                ns_per_point: ns_per(passes * points.len(), d),
                 err_max: errs.iter().copied().fold(0.0, f64::max),
                 err_mean: errs.iter().sum::<f64>() / errs.len() as f64,
             });
@@ -251,111 +280,165 @@ pub fn section(_opts: &Options) -> Result<Section, Box<dyn Error>> {
         }
     }
     bar.finish_and_clear();
+    let half_angles = points.iter().map(|p| p.half_angle);
+    Ok(LobeSumResults {
+        points: points.len(),
+        half_angles: (
+            half_angles.clone().fold(f32::INFINITY, f32::min),
+            half_angles.fold(0.0, f32::max),
+        ),
+        max_unshadowed: scale,
+        reference_seconds: ref_time.as_secs_f64(),
+        model_error: model_err,
+        rows,
+    })
+}
 
-    let base = |ci: usize| {
-        rows.iter()
+impl LobeSumResults {
+    /// Nanoseconds per point of curve `ci` at `t = 0` (the speed ratios' baseline).
+    fn base(&self, ci: usize) -> f64 {
+        self.rows
+            .iter()
             .find(|r| r.curve == ci && r.t == 0.0)
             .map_or(1.0, |r| r.ns_per_point)
-    };
-    let mut table = String::from(
-        "<table><tr><th>kernel fit, cosine</th><th>t / max S</th><th>products / point</th><th>dropped / point</th><th>ns / point</th><th>speed ×(t = 0)</th><th>max error / max S</th><th>mean error / max S</th></tr>\n",
-    );
+    }
+
+    /// Speed of `r` relative to its curve at `t = 0`.
+    fn speed(&self, r: &Row) -> f64 {
+        self.base(r.curve) / r.ns_per_point
+    }
+}
+
+/// The summary text of the section.
+fn summary(r: &LobeSumResults) -> String {
     let mut summary = format!(
-        "  {} points, 1 light, {OCCLUDERS} occluders; references {ref_s:.1} s; error vs lobe-model quadrature / brightest unshadowed value\n",
-        points.len()
+        "  {} points, 1 light, {OCCLUDERS} occluders; references {:.1} s; error vs lobe-model quadrature / brightest unshadowed value\n",
+        r.points, r.reference_seconds
     );
     summary += &format!(
         "  {:<42} {:>8} {:>9} {:>9} {:>7} {:>10} {:>10}\n",
         "fit, cosine", "t/maxS", "products", "ns/point", "×(t=0)", "max err", "mean err"
     );
-    for r in &rows {
-        let c = &CURVES[r.curve];
-        let speed = base(r.curve) / r.ns_per_point;
-        table += &format!(
-            "<tr><td>{}</td><td>{:.0e}</td><td>{:.1}</td><td>{:.1}</td><td>{:.0}</td><td>{:.2}</td><td>{:.2e}</td><td>{:.2e}</td></tr>\n",
-            c.name, r.t, r.products, r.dropped, r.ns_per_point, speed, r.err_max, r.err_mean
-        );
+    for row in &r.rows {
         summary += &format!(
             "  {:<42} {:>8.0e} {:>9.1} {:>9.0} {:>7.2} {:>10.2e} {:>10.2e}\n",
-            c.name, r.t, r.products, r.ns_per_point, speed, r.err_max, r.err_mean
+            name(row),
+            row.t,
+            row.products,
+            row.ns_per_point,
+            r.speed(row),
+            row.err_max,
+            row.err_mean
+        );
+    }
+    summary += &format!(
+        "  lobe model vs physical (cap light, exact occluders), t = 0: max {:.2e}, mean {:.2e} of max S\n",
+        r.model_error.0, r.model_error.1
+    );
+    summary
+}
+
+/// The HTML of the section.
+fn html(r: &LobeSumResults) -> String {
+    let mut table = String::from(
+        "<table><tr><th>kernel fit, cosine</th><th>t / max S</th><th>products / point</th><th>dropped / point</th><th>ns / point</th><th>speed ×(t = 0)</th><th>max error / max S</th><th>mean error / max S</th></tr>\n",
+    );
+    for row in &r.rows {
+        table += &format!(
+            "<tr><td>{}</td><td>{:.0e}</td><td>{:.1}</td><td>{:.1}</td><td>{:.0}</td><td>{:.2}</td><td>{:.2e}</td><td>{:.2e}</td></tr>\n",
+            name(row),
+            row.t,
+            row.products,
+            row.dropped,
+            row.ns_per_point,
+            r.speed(row),
+            row.err_max,
+            row.err_mean
         );
     }
     table += "</table>\n";
-    summary += &format!(
-        "  lobe model vs physical (cap light, exact occluders), t = 0: max {:.2e}, mean {:.2e} of max S\n",
-        model_err.0, model_err.1
-    );
-    let svg = plot(&rows);
-    let html = format!(
+    format!(
         "<p>Figure 16 of the cosine-lobe paper as a curve: {} shaded points on a plane under one \
          spherical light (cap half-angles {:.3}–{:.3} rad) and {OCCLUDERS} sphere occluders, modified \
          Phong (k<sub>d</sub> 0.3, k<sub>s</sub> 0.6, e = 150). For each pruning threshold t (in units of the \
-         brightest unshadowed value, max S = {scale:.4e}) the chain <code>lobe_sum::triple</code> runs over every \
+         brightest unshadowed value, max S = {:.4e}) the chain <code>lobe_sum::triple</code> runs over every \
          point: products computed per point against the error against f64 quadrature of the same lobe \
          model (light and occluders as the chain's cap lobes, exact cosine). The speed ratio is to the \
          same curve at t = 0 in this run. The lobe model itself differs from the physical integral (cap \
          indicator light, exact occluders) by max {:.2e}, mean {:.2e} of max S: that is the caps-as-lobes \
          representation, which no product kernel removes.</p>\n<p><img src=\"lobe_sum.svg\" alt=\"error against products\"></p>\n{table}",
-        points.len(),
-        points
-            .iter()
-            .map(|p| p.half_angle)
-            .fold(f32::INFINITY, f32::min),
-        points.iter().map(|p| p.half_angle).fold(0.0, f32::max),
-        model_err.0,
-        model_err.1,
-    );
-    let data = json!({
-        "points": points.len(),
+        r.points,
+        r.half_angles.0,
+        r.half_angles.1,
+        r.max_unshadowed,
+        r.model_error.0,
+        r.model_error.1,
+    )
+}
+
+/// The data of the section in `report.json`.
+fn data(r: &LobeSumResults) -> serde_json::Value {
+    json!({
+        "points": r.points,
         "occluders": OCCLUDERS,
-        "max_unshadowed": scale,
-        "reference_seconds": ref_s,
-        "model_error_max": model_err.0,
-        "model_error_mean": model_err.1,
-        "rows": rows.iter().map(|r| json!({
-            "fit": CURVES[r.curve].name,
-            "threshold": r.t,
-            "products_per_point": r.products,
-            "dropped_per_point": r.dropped,
-            "ns_per_point": r.ns_per_point,
-            "speed_vs_t0": base(r.curve) / r.ns_per_point,
-            "error_max": r.err_max,
-            "error_mean": r.err_mean,
+        "max_unshadowed": r.max_unshadowed,
+        "reference_seconds": r.reference_seconds,
+        "model_error_max": r.model_error.0,
+        "model_error_mean": r.model_error.1,
+        "rows": r.rows.iter().map(|row| json!({
+            "fit": name(row),
+            "threshold": row.t,
+            "products_per_point": row.products,
+            "dropped_per_point": row.dropped,
+            "ns_per_point": row.ns_per_point,
+            "speed_vs_t0": r.speed(row),
+            "error_max": row.err_max,
+            "error_mean": row.err_mean,
         })).collect::<Vec<_>>(),
-    });
-    Ok(Section {
-        id: "lobe-sum",
-        title: "Lobe sums: ∫ f_r·L·V, error against products (pruning threshold)".into(),
-        summary,
-        html,
-        data,
-        files: vec![("lobe_sum.svg".into(), svg.into_bytes())],
     })
 }
 
 /// Max error (log y) against products per point (x), one line per curve, a point per
-/// threshold.
+/// threshold; the first curve drawn wide, as the others lie on it.
 fn plot(rows: &[Row]) -> String {
     let series: Vec<Series> = CURVES
         .iter()
         .enumerate()
-        .map(|(ci, c)| Series {
-            label: c.name.into(),
-            points: rows
+        .map(|(ci, c)| {
+            let points = rows
                 .iter()
                 .filter(|r| r.curve == ci)
                 .map(|r| Pt {
                     note: Some(format!("{}: t = {:.0e}", c.name, r.t)),
                     ..Pt::new(r.products, r.err_max)
                 })
-                .collect(),
-            line: true,
+                .collect();
+            let s = Series::line(c.name, points);
+            if ci == 0 { s.wide() } else { s }
         })
         .collect();
-    chart(
+    Chart::new(
         "Lobe sums: error against products computed (pruning threshold t)",
-        ("products computed per point", Scale::Linear),
-        ("max error / brightest value", Scale::Log),
-        &series,
+        Axis::new("products computed per point", Scale::Linear),
+        Axis::new("max error / brightest value", Scale::Log),
+        series,
     )
+    .svg()
+}
+
+/// The section of measured results.
+pub fn render(r: &LobeSumResults) -> Section {
+    Section {
+        id: "lobe-sum",
+        title: "Lobe sums: ∫ f_r·L·V, error against products (pruning threshold)".into(),
+        summary: summary(r),
+        html: html(r),
+        data: data(r),
+        files: vec![("lobe_sum.svg".into(), plot(&r.rows).into_bytes())],
+    }
+}
+
+/// The report section (see the module docs).
+pub fn section(opts: &Options) -> Result<Section, Box<dyn Error>> {
+    Ok(render(&measure(opts)?))
 }

@@ -11,14 +11,15 @@ pub mod sat;
 pub mod section;
 pub mod sections;
 pub mod shade;
-mod svg;
+pub mod timing;
 pub mod vdt;
 
 use std::path::PathBuf;
-use std::time::{Duration, Instant};
 
 use indicatif::{ProgressBar, ProgressStyle};
 use serde::Serialize;
+
+use plot::{Axis, Chart, Pt, Scale, Series};
 
 use crate::accuracy::{self, ErrorStats};
 use crate::backend;
@@ -29,14 +30,22 @@ use crate::workload;
 /// Seed of the default workload.
 pub const SEED: u64 = 0x57e4_ad1a;
 
+/// The default of [`Options::n`]: the workload sizes written in the sections are theirs at
+/// this `n`.
+pub const DEFAULT_N: usize = 1 << 20;
+
 /// What to run.
 #[derive(Clone, Debug)]
 pub struct Options {
     /// Output directory.
     pub out: PathBuf,
-    /// Inputs per kernel for throughput.
+    /// Size of the throughput workloads: inputs per kernel of the top table; every section's
+    /// throughput workload (queries, products, … per timed run) is its default times
+    /// `n / DEFAULT_N` ([`Options::scaled`]). The sections' error samples do not change with
+    /// it; the top table's errors are over its first `min(n, error_rows)` inputs.
     pub n: usize,
-    /// Timed repeats per kernel × backend (the median is reported).
+    /// Timed runs of every throughput measurement, of the top table and of every section
+    /// (after one untimed warm-up run; the median is reported).
     pub repeats: usize,
     /// Rows compared against the f64 reference (hard cases first).
     pub error_rows: usize,
@@ -48,11 +57,19 @@ impl Default for Options {
     fn default() -> Self {
         Options {
             out: PathBuf::from("report"),
-            n: 1 << 20,
+            n: DEFAULT_N,
             repeats: 7,
             error_rows: 1 << 16,
             gpu: true,
         }
+    }
+}
+
+impl Options {
+    /// A section's throughput workload size of `default` at the default `n`, scaled to this
+    /// run's `n`: `max(1, default · n / DEFAULT_N)`.
+    pub fn scaled(&self, default: usize) -> usize {
+        (default as u128 * self.n as u128 / DEFAULT_N as u128).clamp(1, usize::MAX as u128) as usize
     }
 }
 
@@ -165,41 +182,31 @@ pub fn run(opts: &Options) -> Result<Report, Box<dyn std::error::Error>> {
         let reference = accuracy::reference(k, &input, opts.error_rows);
         bar.inc(1);
         // Backends take turns within each repeat, so a noisy machine slows them alike and
-        // the ratios between them stay meaningful.
+        // the ratios between them stay meaningful; the warm-up round also compiles GPU
+        // pipelines. A backend that fails is not run again.
         let mut outs: Vec<Columns> = backends
             .iter()
             .map(|_| Columns::zeros(k.output_arity(), opts.n))
             .collect();
-        let mut times: Vec<Vec<Duration>> = vec![Vec::new(); backends.len()];
         let mut failed: Vec<Option<String>> = vec![None; backends.len()];
-        for rep in 0..=opts.repeats.max(1) {
-            for (bi, b) in backends.iter_mut().enumerate() {
-                if failed[bi].is_some() {
-                    continue;
-                }
-                bar.set_message(format!("{k} on {} ({rep}/{})", b.name(), opts.repeats));
-                let t = Instant::now();
-                match b.run(k, &input, &mut outs[bi]) {
-                    // The first round warms caches and compiles GPU pipelines.
-                    Ok(()) if rep > 0 => times[bi].push(t.elapsed()),
-                    Ok(()) => {}
-                    Err(e) => failed[bi] = Some(e.to_string()),
-                }
+        bar.set_message(format!("{k} on every backend ({} repeats)", opts.repeats));
+        let times = timing::median_times_in_turns(opts.repeats, backends.len(), |bi| {
+            if failed[bi].is_none()
+                && let Err(e) = backends[bi].run(k, &input, &mut outs[bi])
+            {
+                failed[bi] = Some(e.to_string());
             }
-        }
+        });
         for (bi, b) in backends.iter().enumerate() {
             if let Some(e) = &failed[bi] {
                 bar.println(format!("{k} on {}: {e}", b.name()));
             } else {
-                let ts = &mut times[bi];
-                ts.sort();
-                let t = ts[ts.len() / 2];
                 let error = accuracy::stats(&reference, &input, &outs[bi]);
                 let bound = accuracy::bound(k);
                 results.push(Row {
                     kernel: k.name(),
                     backend: b.name(),
-                    evals_per_s: opts.n as f64 / t.as_secs_f64().max(1e-12),
+                    evals_per_s: timing::per_second(opts.n, times[bi]),
                     n: opts.n,
                     within_bound: error.max <= bound,
                     error,
@@ -338,7 +345,7 @@ documented on the kernel.</p>
         cores = m.cores,
         simd = esc(&m.simd),
         gpu = esc(&m.gpu_description()),
-        svg = svg::speed_vs_error(r),
+        svg = speed_vs_error(r),
         sections = r
             .sections
             .iter()
@@ -350,4 +357,59 @@ documented on the kernel.</p>
             ))
             .collect::<String>(),
     )
+}
+
+/// The speed-against-error figure: one panel per kernel, a point per backend, log axes,
+/// the kernel's documented bound as a dashed line.
+fn speed_vs_error(r: &Report) -> String {
+    const BACKENDS: [&str; 4] = ["cpu-scalar", "cpu-scalar-loop", "cpu-simd", "wgpu"];
+    let mut kernels: Vec<&str> = Vec::new();
+    for row in &r.results {
+        if !kernels.contains(&row.kernel) {
+            kernels.push(row.kernel);
+        }
+    }
+    let panels: Vec<Chart> = kernels
+        .iter()
+        .map(|&k| {
+            let rows: Vec<&Row> = r.results.iter().filter(|row| row.kernel == k).collect();
+            // Every panel lists every backend, so that each has one colour throughout.
+            let series = BACKENDS
+                .iter()
+                .map(|&b| {
+                    let points = rows
+                        .iter()
+                        .filter(|row| row.backend == b)
+                        .map(|row| {
+                            // A non-finite error is drawn at 1, an exact one on the floor.
+                            let e = if row.error.max.is_finite() {
+                                row.error.max
+                            } else {
+                                1.0
+                            };
+                            Pt {
+                                note: Some(format!(
+                                    "{k} {b}: {:.3e} evals/s, max error {:.3e}",
+                                    row.evals_per_s, row.error.max
+                                )),
+                                ..Pt::new(row.evals_per_s.max(1.0), e)
+                            }
+                        })
+                        .collect();
+                    Series::dots(b, points)
+                })
+                .collect();
+            let chart = Chart::new(
+                k,
+                Axis::new("evals/s", Scale::Log),
+                Axis::new("max error", Scale::Log),
+                series,
+            );
+            match rows.first() {
+                Some(row) => chart.rule(row.bound, format!("bound ({})", row.error.metric)),
+                None => chart,
+            }
+        })
+        .collect();
+    plot::grid(&panels, 3, (300.0, 220.0))
 }

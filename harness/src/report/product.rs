@@ -7,7 +7,7 @@ use std::error::Error;
 use std::f64::consts::{PI, TAU};
 use std::fmt::Write as _;
 use std::hint::black_box;
-use std::time::{Duration, Instant};
+use std::time::Duration;
 
 use indicatif::{ProgressBar, ProgressStyle};
 use serde_json::json;
@@ -15,8 +15,9 @@ use steradian_core::lobe::CosineLobe;
 use steradian_core::lobe::product::{self, ProductFit, ProductTable};
 
 use super::Options;
-use super::plot::{Pt, Scale, Series, chart};
+use super::plot::{Axis, Chart, Pt, Scale, Series};
 use super::section::Section;
+use super::timing::{median_times_in_turns, per_second, timed};
 use crate::generate::lobe_product;
 use crate::product::canonical_lobes;
 use crate::reference::product::{coplanar_triple, ln_product_integral, product_integral};
@@ -28,10 +29,8 @@ const SEED: u64 = 0x10be_9a0d;
 const ERROR_POINTS: usize = 4000;
 /// Points for the shape error.
 const SHAPE_POINTS: usize = 800;
-/// Products per timed run.
+/// Products per timed run at the default `--n` ([`Options::scaled`]).
 const SPEED_N: usize = 1 << 15;
-/// Timed repeats (median reported).
-const REPEATS: usize = 5;
 /// Table resolutions generated at run time, besides the built-in one.
 const RESOLUTIONS: [(usize, usize); 3] = [(12, 16), (24, 32), (40, 64)];
 
@@ -109,35 +108,105 @@ pub fn third_lobe_error(
         .then(|| (approx / exact - 1.0).abs())
 }
 
-struct TableRow {
-    name: String,
-    bytes: usize,
-    errs: Vec<f64>,
-    per_s: f64,
+/// One table (or the closed form) of the section: its integral error and scalar speed.
+#[derive(Clone, Debug)]
+pub struct TableResult {
+    /// What the integral comes from.
+    pub name: String,
+    /// Bytes of the table (0 for the closed form).
+    pub bytes: usize,
+    /// Median scalar products per second.
+    pub products_per_s: f64,
+    /// Mean relative integral error.
+    pub mean: f64,
+    /// Its 99th percentile.
+    pub p99: f64,
+    /// Its maximum.
+    pub max: f64,
+    /// Points the errors are over.
+    pub points: usize,
 }
 
-/// Median products per second of `fit` with `table` over `lobes`, each call behind
+/// Batch throughput of the built-in table, timed in turns.
+#[derive(Clone, Debug)]
+pub struct BatchResult {
+    /// cpu-scalar products per second.
+    pub scalar: f64,
+    /// cpu-simd products per second.
+    pub simd: f64,
+    /// wgpu products per second and the adapter, or why not.
+    pub gpu: Result<(f64, String), String>,
+}
+
+/// The error distribution of one product fit (shape or rendering error).
+#[derive(Clone, Debug)]
+pub struct FitErrors {
+    /// The fit.
+    pub fit: &'static str,
+    /// Median.
+    pub median: f64,
+    /// 90th percentile.
+    pub p90: f64,
+    /// 99th percentile.
+    pub p99: f64,
+    /// Maximum.
+    pub max: f64,
+    /// Mean.
+    pub mean: f64,
+    /// Points.
+    pub points: usize,
+}
+
+impl FitErrors {
+    fn of(fit: &'static str, sorted: &[f64]) -> Self {
+        FitErrors {
+            fit,
+            median: quantile(sorted, 0.5),
+            p90: quantile(sorted, 0.9),
+            p99: quantile(sorted, 0.99),
+            max: quantile(sorted, 1.0),
+            mean: mean(sorted),
+            points: sorted.len(),
+        }
+    }
+}
+
+/// Everything the section measures.
+#[derive(Clone, Debug)]
+pub struct ProductResults {
+    /// Generated tables, the built-in one, then the closed form.
+    pub tables: Vec<TableResult>,
+    /// Index of the built-in table in `tables`.
+    pub builtin: usize,
+    /// Batch throughput of the built-in table.
+    pub batch: BatchResult,
+    /// The tables generated in this run and how long each took.
+    pub generated: Vec<(String, Duration)>,
+    /// Points of the shape and rendering errors.
+    pub shape_points: usize,
+    /// Relative L2 shape error per fit.
+    pub shapes: Vec<FitErrors>,
+    /// Rendering (third-lobe) error per fit.
+    pub renders: Vec<FitErrors>,
+}
+
+/// Computes `fit` with `table` for every pair of `lobes` into `out`, each call behind
 /// `black_box` (one product at a time, as a renderer calls it).
-fn time_scalar(
+fn run_scalar(
     table: &ProductTable<'_>,
     fit: ProductFit,
     lobes: &[(CosineLobe, CosineLobe)],
     out: &mut [CosineLobe],
-) -> Duration {
-    let t = Instant::now();
+) {
     for ((a, b), o) in lobes.iter().zip(out.iter_mut()) {
         *o = product::product_with(black_box(table), fit, black_box(a), black_box(b));
     }
     black_box(&out);
-    t.elapsed()
 }
 
-/// Batch throughput of the built-in table: `(cpu-simd products/s, wgpu products/s or why
-/// not)`, timed in turns with the scalar kernel, and the scalar rate of the same run.
-fn batch_speeds(
-    lobes: &[(CosineLobe, CosineLobe)],
-    gpu: bool,
-) -> (f64, f64, Result<(f64, String), String>) {
+/// Batch throughput of the built-in table: cpu-scalar, cpu-simd and wgpu (or why not),
+/// timed in turns over `repeats` rounds.
+fn batch_speeds(lobes: &[(CosineLobe, CosineLobe)], gpu: bool, repeats: usize) -> BatchResult {
     let n = lobes.len();
     let col = |f: &dyn Fn(&(CosineLobe, CosineLobe)) -> f32| -> Vec<f32> {
         lobes.iter().map(f).collect()
@@ -174,12 +243,10 @@ fn batch_speeds(
     let mut gout = crate::kernels::Columns::zeros(5, n);
     let gtable = crate::backend::gpu_product::ProductGpuTable::builtin();
     let mut scalar_out = vec![lobes[0].0; n];
-    let (mut ts, mut tv, mut tg) = (Vec::new(), Vec::new(), Vec::new());
     let mut gpu_err = None;
-    for rep in 0..=REPEATS {
-        let d = time_scalar(&table, ProductFit::ExactIntegral, lobes, &mut scalar_out);
-        let t = Instant::now();
-        {
+    let times = median_times_in_turns(repeats, 3, |i| match i {
+        0 => run_scalar(&table, ProductFit::ExactIntegral, lobes, &mut scalar_out),
+        1 => {
             let [o0, o1, o2, o3, o4] = &mut out;
             steradian_simd::lobe::product::product_slices(
                 &table,
@@ -194,40 +261,46 @@ fn batch_speeds(
                 o3,
                 o4,
             );
+            black_box(&out);
         }
-        black_box(&out);
-        let dv = t.elapsed();
-        if let (Ok((g, _)), Ok(gt), None) = (&mut gpu_state, &gtable, &gpu_err) {
-            let t = Instant::now();
-            match crate::backend::gpu_product::run_lobe_product_columns(g, gt, &input, &mut gout) {
-                Ok(()) if rep > 0 => tg.push(t.elapsed()),
-                Ok(()) => {}
-                Err(e) => gpu_err = Some(e.to_string()),
+        _ => {
+            if let (Ok((g, _)), Ok(gt), None) = (&mut gpu_state, &gtable, &gpu_err) {
+                let r =
+                    crate::backend::gpu_product::run_lobe_product_columns(g, gt, &input, &mut gout);
+                if let Err(e) = r {
+                    gpu_err = Some(e.to_string());
+                }
             }
         }
-        if rep > 0 {
-            ts.push(d);
-            tv.push(dv);
-        }
+    });
+    let gpu = match (gpu_state, gtable, gpu_err) {
+        (Err(why), _, _) => Err(why),
+        (_, Err(e), _) => Err(e.to_string()),
+        (_, _, Some(e)) => Err(e),
+        (Ok((_, info)), Ok(_), None) => Ok((per_second(n, times[2]), info)),
+    };
+    BatchResult {
+        scalar: per_second(n, times[0]),
+        simd: per_second(n, times[1]),
+        gpu,
     }
-    let rate = |v: &mut Vec<Duration>| {
-        v.sort();
-        n as f64 / v[v.len() / 2].as_secs_f64().max(1e-12)
-    };
-    let gpu = match (gpu_state, gpu_err) {
-        (Err(why), _) => Err(why),
-        (_, Some(e)) => Err(e),
-        (Ok((_, info)), None) if !tg.is_empty() => Ok((rate(&mut tg), info)),
-        (Ok(_), None) => Err(match gtable {
-            Err(e) => e.to_string(),
-            Ok(_) => "no timing".into(),
-        }),
-    };
-    (rate(&mut ts), rate(&mut tv), gpu)
 }
 
-/// Runs the section.
-pub fn section(opts: &Options) -> Result<Section, Box<dyn Error>> {
+/// The product fits of the shape and rendering errors.
+const FITS: [(&str, ProductFit); 3] = [
+    (
+        "exact integral, peak-matched (default)",
+        ProductFit::ExactIntegral,
+    ),
+    (
+        "exact integral, curvature-matched",
+        ProductFit::ExactIntegralCurvature,
+    ),
+    ("spherical Gaussian", ProductFit::SphericalGaussian),
+];
+
+/// Runs the section's measurements.
+pub fn measure(opts: &Options) -> Result<ProductResults, Box<dyn Error>> {
     let steps = (RESOLUTIONS.len() + 5) as u64;
     let bar = ProgressBar::new(steps).with_style(
         ProgressStyle::with_template("{spinner} [{elapsed_precise}] {bar:30} {pos}/{len} {msg}")
@@ -253,9 +326,8 @@ pub fn section(opts: &Options) -> Result<Section, Box<dyn Error>> {
     let mut owned: Vec<(String, Vec<u8>, Duration)> = Vec::new();
     for (ne, nw) in RESOLUTIONS {
         bar.set_message(format!("lobe products: generating a {ne}×{ne}×{nw} table"));
-        let t = Instant::now();
-        let bytes = lobe_product::encode(ne, nw);
-        owned.push((format!("{ne}×{ne}×{nw} table"), bytes, t.elapsed()));
+        let (bytes, d) = timed(|| lobe_product::encode(ne, nw));
+        owned.push((format!("{ne}×{ne}×{nw} table"), bytes, d));
         bar.inc(1);
     }
     let mut tables: Vec<(String, ProductTable<'_>, ProductFit)> = owned
@@ -285,56 +357,44 @@ pub fn section(opts: &Options) -> Result<Section, Box<dyn Error>> {
     ));
 
     bar.set_message("lobe products: errors and scalar throughput");
-    let lobes: Vec<(CosineLobe, CosineLobe)> = (0..SPEED_N)
+    let speed_n = opts.scaled(SPEED_N);
+    let lobes: Vec<(CosineLobe, CosineLobe)> = (0..speed_n)
         .map(|_| {
             let (e1, e2) = (exponent(&mut rng), exponent(&mut rng));
             canonical_lobes(e1, e2, (PI * rng.unit()) as f32)
         })
         .collect();
-    let mut out = vec![lobes[0].0; SPEED_N];
-    let mut times: Vec<Vec<Duration>> = vec![Vec::new(); tables.len()];
-    for rep in 0..=REPEATS {
-        // Tables take turns within each repeat, so noise hits them alike.
-        for (i, (_, t, fit)) in tables.iter().enumerate() {
-            let d = time_scalar(t, *fit, &lobes, &mut out);
-            if rep > 0 {
-                times[i].push(d);
-            }
-        }
-    }
-    let rows: Vec<TableRow> = tables
+    let mut out = vec![lobes[0].0; speed_n];
+    // Tables take turns within each repeat, so noise hits them alike.
+    let times = median_times_in_turns(opts.repeats, tables.len(), |i| {
+        let (_, t, fit) = &tables[i];
+        run_scalar(t, *fit, &lobes, &mut out);
+    });
+    let rows: Vec<TableResult> = tables
         .iter()
-        .zip(times.iter_mut())
-        .map(|((name, t, fit), ts)| {
-            ts.sort();
-            TableRow {
+        .zip(&times)
+        .map(|((name, t, fit), &d)| {
+            let errs = integral_errors(t, *fit, &points);
+            TableResult {
                 name: name.clone(),
                 bytes: if *fit == ProductFit::SphericalGaussian {
                     0
                 } else {
                     t.bytes()
                 },
-                errs: integral_errors(t, *fit, &points),
-                per_s: SPEED_N as f64 / ts[ts.len() / 2].as_secs_f64().max(1e-12),
+                products_per_s: per_second(speed_n, d),
+                mean: mean(&errs),
+                p99: quantile(&errs, 0.99),
+                max: quantile(&errs, 1.0),
+                points: errs.len(),
             }
         })
         .collect();
     bar.set_message("lobe products: SIMD and wgpu throughput");
-    let (batch_scalar, batch_simd, batch_gpu) = batch_speeds(&lobes, opts.gpu);
+    let batch = batch_speeds(&lobes, opts.gpu, opts.repeats);
     bar.inc(1);
 
     bar.set_message("lobe products: shape errors");
-    let fits = [
-        (
-            "exact integral, peak-matched (default)",
-            ProductFit::ExactIntegral,
-        ),
-        (
-            "exact integral, curvature-matched",
-            ProductFit::ExactIntegralCurvature,
-        ),
-        ("spherical Gaussian", ProductFit::SphericalGaussian),
-    ];
     let shape_points: Vec<(f32, f32, f32)> = points
         .iter()
         .filter(|&&(e1, e2, _, ln_i)| ln_i.exp() >= 1e-6 * TAU / (e1.max(e2) as f64 + 1.0))
@@ -342,7 +402,7 @@ pub fn section(opts: &Options) -> Result<Section, Box<dyn Error>> {
         .map(|&(e1, e2, a, _)| (e1, e2, a))
         .collect();
     let builtin = ProductTable::builtin();
-    let shapes: Vec<(&str, Vec<f64>)> = fits
+    let shapes: Vec<FitErrors> = FITS
         .iter()
         .map(|&(name, fit)| {
             let mut v: Vec<f64> = shape_points
@@ -354,7 +414,7 @@ pub fn section(opts: &Options) -> Result<Section, Box<dyn Error>> {
                 .filter(|x| x.is_finite())
                 .collect();
             v.sort_by(f64::total_cmp);
-            (name, v)
+            FitErrors::of(name, &v)
         })
         .collect();
     // Rendering error: one more lobe on the arc, around the product's peak.
@@ -368,7 +428,7 @@ pub fn section(opts: &Options) -> Result<Section, Box<dyn Error>> {
             )
         })
         .collect();
-    let renders: Vec<(&str, Vec<f64>)> = fits
+    let renders: Vec<FitErrors> = FITS
         .iter()
         .map(|&(name, fit)| {
             let mut v: Vec<f64> = shape_points
@@ -381,19 +441,109 @@ pub fn section(opts: &Options) -> Result<Section, Box<dyn Error>> {
                 })
                 .collect();
             v.sort_by(f64::total_cmp);
-            (name, v)
+            FitErrors::of(name, &v)
         })
         .collect();
     bar.inc(1);
     bar.finish_and_clear();
+    Ok(ProductResults {
+        tables: rows,
+        builtin: RESOLUTIONS.len(),
+        batch,
+        generated: owned.into_iter().map(|(n, _, d)| (n, d)).collect(),
+        shape_points: shape_points.len(),
+        shapes,
+        renders,
+    })
+}
 
-    // Text, HTML, JSON, plot.
-    let mut summary = String::new();
+/// The line of the wgpu batch rate, or why there is none.
+fn gpu_line(b: &BatchResult) -> String {
+    match &b.gpu {
+        Ok((r, info)) => format!(
+            "wgpu {:.2} M/s ({:.2}× scalar, upload and read-back included, on {info})",
+            r / 1e6,
+            r / b.scalar
+        ),
+        Err(why) => format!("wgpu: not run ({why})"),
+    }
+}
+
+/// "name in 0.12 s" for each generated table.
+fn generated(r: &ProductResults) -> Vec<String> {
+    r.generated
+        .iter()
+        .map(|(n, d)| format!("{n} in {:.2} s", d.as_secs_f64()))
+        .collect()
+}
+
+/// The summary text of the section.
+fn summary(r: &ProductResults) -> String {
+    let mut s = String::new();
     let _ = writeln!(
-        summary,
+        s,
         "  {:<34} {:>10} {:>12} {:>10} {:>10} {:>10}",
         "lobe product (scalar, 1 core)", "bytes", "Mproducts/s", "mean", "p99", "max"
     );
+    for t in &r.tables {
+        let _ = writeln!(
+            s,
+            "  {:<34} {:>10} {:>12.2} {:>10.2e} {:>10.2e} {:>10.2e}",
+            t.name,
+            t.bytes,
+            t.products_per_s / 1e6,
+            t.mean,
+            t.p99,
+            t.max
+        );
+    }
+    let b = &r.batch;
+    let _ = writeln!(
+        s,
+        "  built-in table, same run: cpu-scalar {:.2} M/s, cpu-simd {:.2} M/s ({:.2}× scalar, {} lanes, {}), {}",
+        b.scalar / 1e6,
+        b.simd / 1e6,
+        b.simd / b.scalar,
+        steradian_simd::slice_lanes(),
+        steradian_simd::isa(),
+        gpu_line(b)
+    );
+    let _ = writeln!(
+        s,
+        "  contract for the built-in table: mean ≤ {:.0e}, p99 ≤ {:.0e}, max ≤ {:.0e}",
+        product::INTEGRAL_REL_MEAN,
+        product::INTEGRAL_REL_P99,
+        product::INTEGRAL_REL_MAX
+    );
+    let _ = writeln!(s, "  generated here: {}", generated(r).join(", "));
+    let _ = writeln!(
+        s,
+        "  relative L2 shape error of the result lobe ({} points, built-in table):",
+        r.shape_points
+    );
+    for e in &r.shapes {
+        let _ = writeln!(
+            s,
+            "    {:<40} median {:.2e}  p90 {:.2e}  p99 {:.2e}  max {:.2e}",
+            e.fit, e.median, e.p90, e.p99, e.max
+        );
+    }
+    let _ = writeln!(
+        s,
+        "  rendering error: ∫ c_r·c3 against the exact ∫ c1·c2·c3, c3 a third lobe (e3 log-uniform in [1, 1e4]) on the arc:"
+    );
+    for e in &r.renders {
+        let _ = writeln!(
+            s,
+            "    {:<40} median {:.2e}  p90 {:.2e}  p99 {:.2e}  mean {:.2e}",
+            e.fit, e.median, e.p90, e.p99, e.mean
+        );
+    }
+    s
+}
+
+/// The HTML of the section.
+fn html(r: &ProductResults) -> String {
     let mut html = String::from(
         "<p>Relative error of the result lobe's integral <code>2πp/(e_r+1)</code> against the exact \
          product integral (f64), on unseen points: <code>e</code> = 0 with probability 5 %, else \
@@ -403,177 +553,129 @@ pub fn section(opts: &Options) -> Result<Section, Box<dyn Error>> {
          same run.</p>\n<table><tr><th>integral from</th><th>bytes</th><th>Mproducts/s</th>\
          <th>×built-in</th><th>mean</th><th>p99</th><th>max</th></tr>\n",
     );
-    let builtin_speed = rows[RESOLUTIONS.len()].per_s;
-    let mut points_svg = Vec::new();
-    let mut json_rows = Vec::new();
-    for r in &rows {
-        let (m, p99, mx) = (
-            mean(&r.errs),
-            quantile(&r.errs, 0.99),
-            quantile(&r.errs, 1.0),
-        );
-        let _ = writeln!(
-            summary,
-            "  {:<34} {:>10} {:>12.2} {:>10.2e} {:>10.2e} {:>10.2e}",
-            r.name,
-            r.bytes,
-            r.per_s / 1e6,
-            m,
-            p99,
-            mx
-        );
+    let builtin_speed = r.tables[r.builtin].products_per_s;
+    for t in &r.tables {
         let _ = writeln!(
             html,
             "<tr><td>{}</td><td>{}</td><td>{:.2}</td><td>{:.2}</td><td>{:.2e}</td><td>{:.2e}</td><td>{:.2e}</td></tr>",
-            r.name,
-            r.bytes,
-            r.per_s / 1e6,
-            r.per_s / builtin_speed,
-            m,
-            p99,
-            mx
+            t.name,
+            t.bytes,
+            t.products_per_s / 1e6,
+            t.products_per_s / builtin_speed,
+            t.mean,
+            t.p99,
+            t.max
         );
-        points_svg.push(Series {
-            label: r.name.clone(),
-            points: vec![Pt {
-                y_hi: Some(mx),
-                ..Pt::new(r.per_s, m)
-            }],
-            line: false,
-        });
-        json_rows.push(json!({
-            "name": r.name, "bytes": r.bytes, "products_per_s": r.per_s,
-            "mean": m, "p99": p99, "max": mx, "points": r.errs.len(),
-        }));
     }
     html += "</table>\n";
-    let simd_ratio = batch_simd / batch_scalar;
-    let gpu_line = match &batch_gpu {
-        Ok((r, info)) => format!(
-            "wgpu {:.2} M/s ({:.2}× scalar, upload and read-back included, on {info})",
-            r / 1e6,
-            r / batch_scalar
-        ),
-        Err(why) => format!("wgpu: not run ({why})"),
-    };
-    let _ = writeln!(
-        summary,
-        "  built-in table, same run: cpu-scalar {:.2} M/s, cpu-simd {:.2} M/s ({:.2}× scalar, {} lanes, {}), {gpu_line}",
-        batch_scalar / 1e6,
-        batch_simd / 1e6,
-        simd_ratio,
-        steradian_simd::slice_lanes(),
-        steradian_simd::isa()
-    );
+    let b = &r.batch;
     html += &format!(
         "<p>Batches with the built-in table, timed in turns in this run: cpu-scalar {:.2} M products/s, \
          cpu-simd {:.2} M/s (<b>{:.2}×</b> scalar, {} lanes, {}), {}.</p>\n",
-        batch_scalar / 1e6,
-        batch_simd / 1e6,
-        simd_ratio,
+        b.scalar / 1e6,
+        b.simd / 1e6,
+        b.simd / b.scalar,
         steradian_simd::slice_lanes(),
         steradian_simd::isa(),
-        gpu_line
+        gpu_line(b)
     );
-    let _ = writeln!(
-        summary,
-        "  contract for the built-in table: mean ≤ {:.0e}, p99 ≤ {:.0e}, max ≤ {:.0e}",
-        product::INTEGRAL_REL_MEAN,
-        product::INTEGRAL_REL_P99,
-        product::INTEGRAL_REL_MAX
-    );
-    let generated: Vec<String> = owned
-        .iter()
-        .map(|(n, _, d)| format!("{n} in {:.2} s", d.as_secs_f64()))
-        .collect();
-    let _ = writeln!(summary, "  generated here: {}", generated.join(", "));
     html += &format!(
         "<p>Generated in this run (f64 exact integrals): {}.</p>\n",
-        generated.join(", ")
+        generated(r).join(", ")
     );
     html += "<img src=\"lobe_product.svg\" alt=\"lobe product: speed against error\">\n";
-
-    let _ = writeln!(
-        summary,
-        "  relative L2 shape error of the result lobe ({} points, built-in table):",
-        shape_points.len()
-    );
     html += &format!(
         "<p>Relative L2 shape error <code>‖c_r − c1·c2‖/‖c1·c2‖</code> of the result lobe \
          over {} of those points (exact 1-D integrals). It cannot be 0: a product of lobes is \
          not a lobe.</p>\n<table><tr><th>fit</th><th>median</th><th>p90</th><th>p99</th><th>max</th></tr>\n",
-        shape_points.len()
+        r.shape_points
     );
-    let mut json_shapes = Vec::new();
-    for (name, v) in &shapes {
-        let q = [0.5, 0.9, 0.99, 1.0].map(|q| quantile(v, q));
-        let _ = writeln!(
-            summary,
-            "    {:<40} median {:.2e}  p90 {:.2e}  p99 {:.2e}  max {:.2e}",
-            name, q[0], q[1], q[2], q[3]
-        );
+    for e in &r.shapes {
         let _ = writeln!(
             html,
-            "<tr><td>{name}</td><td>{:.2e}</td><td>{:.2e}</td><td>{:.2e}</td><td>{:.2e}</td></tr>",
-            q[0], q[1], q[2], q[3]
+            "<tr><td>{}</td><td>{:.2e}</td><td>{:.2e}</td><td>{:.2e}</td><td>{:.2e}</td></tr>",
+            e.fit, e.median, e.p90, e.p99, e.max
         );
-        json_shapes
-            .push(json!({"fit": name, "median": q[0], "p90": q[1], "p99": q[2], "max": q[3]}));
     }
     html += "</table>\n";
-
-    let _ = writeln!(
-        summary,
-        "  rendering error: ∫ c_r·c3 against the exact ∫ c1·c2·c3, c3 a third lobe (e3 log-uniform in [1, 1e4]) on the arc:"
-    );
     html += "<p>Rendering error of each fit: the result multiplied by a third lobe \
              <code>c3</code> (exponent log-uniform in [1, 1e4], axis on the arc around the peak), \
              <code>|∫c_r·c3 − ∫c1·c2·c3|/∫c1·c2·c3</code> with both integrals exact. This is the \
              measure the default fit was chosen by.</p>\n<table><tr><th>fit</th><th>median</th>\
              <th>p90</th><th>p99</th><th>mean</th></tr>\n";
-    let mut json_renders = Vec::new();
-    for (name, v) in &renders {
-        let q = [0.5, 0.9, 0.99].map(|q| quantile(v, q));
-        let m = mean(v);
-        let _ = writeln!(
-            summary,
-            "    {:<40} median {:.2e}  p90 {:.2e}  p99 {:.2e}  mean {:.2e}",
-            name, q[0], q[1], q[2], m
-        );
+    for e in &r.renders {
         let _ = writeln!(
             html,
-            "<tr><td>{name}</td><td>{:.2e}</td><td>{:.2e}</td><td>{:.2e}</td><td>{:.2e}</td></tr>",
-            q[0], q[1], q[2], m
+            "<tr><td>{}</td><td>{:.2e}</td><td>{:.2e}</td><td>{:.2e}</td><td>{:.2e}</td></tr>",
+            e.fit, e.median, e.p90, e.p99, e.mean
         );
-        json_renders.push(json!({"fit": name, "median": q[0], "p90": q[1], "p99": q[2], "mean": m, "points": v.len()}));
     }
     html += "</table>\n";
+    html
+}
 
-    let svg = chart(
+/// The data of the section in `report.json`.
+fn data(r: &ProductResults) -> serde_json::Value {
+    let b = &r.batch;
+    json!({
+        "tables": r.tables.iter().map(|t| json!({
+            "name": t.name, "bytes": t.bytes, "products_per_s": t.products_per_s,
+            "mean": t.mean, "p99": t.p99, "max": t.max, "points": t.points,
+        })).collect::<Vec<_>>(),
+        "shape_error": r.shapes.iter().map(|e| json!({
+            "fit": e.fit, "median": e.median, "p90": e.p90, "p99": e.p99, "max": e.max,
+        })).collect::<Vec<_>>(),
+        "third_lobe_error": r.renders.iter().map(|e| json!({
+            "fit": e.fit, "median": e.median, "p90": e.p90, "p99": e.p99, "mean": e.mean,
+            "points": e.points,
+        })).collect::<Vec<_>>(),
+        "batch": {
+            "cpu_scalar_per_s": b.scalar,
+            "cpu_simd_per_s": b.simd,
+            "simd_over_scalar": b.simd / b.scalar,
+            "wgpu_per_s": b.gpu.as_ref().ok().map(|g| g.0),
+        },
+    })
+}
+
+/// Scalar speed against integral error, a point per table with a bar from mean to max.
+fn plot(r: &ProductResults) -> String {
+    let series = r
+        .tables
+        .iter()
+        .map(|t| {
+            let pt = Pt {
+                y_hi: Some(t.max),
+                ..Pt::new(t.products_per_s, t.mean)
+            };
+            Series::dots(t.name.clone(), vec![pt])
+        })
+        .collect();
+    Chart::new(
         "Lobe product: scalar speed against integral error",
-        ("products per second (one core)", Scale::Log),
-        (
+        Axis::new("products per second (one core)", Scale::Log),
+        Axis::new(
             "relative integral error (dot: mean, bar to max)",
             Scale::Log,
         ),
-        &points_svg,
-    );
-    Ok(Section {
+        series,
+    )
+    .svg()
+}
+
+/// The section of measured results.
+pub fn render(r: &ProductResults) -> Section {
+    Section {
         id: "lobe-product",
         title: "Lobe products".into(),
-        summary,
-        html,
-        data: json!({
-            "tables": json_rows,
-            "shape_error": json_shapes,
-            "third_lobe_error": json_renders,
-            "batch": {
-                "cpu_scalar_per_s": batch_scalar,
-                "cpu_simd_per_s": batch_simd,
-                "simd_over_scalar": simd_ratio,
-                "wgpu_per_s": batch_gpu.as_ref().ok().map(|g| g.0),
-            },
-        }),
-        files: vec![("lobe_product.svg".into(), svg.into_bytes())],
-    })
+        summary: summary(r),
+        html: html(r),
+        data: data(r),
+        files: vec![("lobe_product.svg".into(), plot(r).into_bytes())],
+    }
+}
+
+/// Runs the section.
+pub fn section(opts: &Options) -> Result<Section, Box<dyn Error>> {
+    Ok(render(&measure(opts)?))
 }

@@ -7,14 +7,16 @@
 use std::error::Error;
 use std::fmt::Write as _;
 use std::hint::black_box;
-use std::time::{Duration, Instant};
+use std::time::Duration;
 
 use indicatif::{ProgressBar, ProgressStyle};
 use serde_json::json;
 use steradian_core::rsl::sat::Sat;
 
 use super::Options;
+use super::plot::{Axis, Chart, Pt, Scale, Series};
 use super::section::Section;
+use super::timing::{median_time, ns_per};
 use crate::backend::gpu::try_gpu;
 use crate::kernels::Columns;
 use crate::rng::Rng;
@@ -27,12 +29,14 @@ const SEED: u64 = 0x5a7_5eed;
 const SIDES: [usize; 6] = [64, 128, 256, 512, 1024, 2048];
 /// Random boxes per resolution for the error table.
 const ERROR_BOXES: usize = 1500;
-/// Queries per timed run.
+/// Queries per timed run at the default `--n` ([`Options::scaled`]).
 const QUERIES: usize = 1 << 18;
-/// Queries of the warm (in-cache) runs, repeated `QUERIES / WARM` times.
+/// Queries of the warm (in-cache) runs, repeated to make up the timed run's queries.
 const WARM: usize = 4096;
-/// Timed repeats (median reported; also the `vdt` section's).
-pub(super) const REPEATS: usize = 5;
+/// Side of the speed measurements and of the high-dynamic-range grid.
+const SIDE: usize = 1024;
+/// Boxes of the wgpu error check (the first of the timed queries).
+const GPU_CHECKED: usize = 4000;
 
 /// A grid of texels uniform in `[0, 1)` (the issue's measurement).
 pub fn uniform_grid(n: usize, seed: u64) -> Grid {
@@ -66,35 +70,21 @@ pub fn random_boxes(n: usize, count: usize, seed: u64) -> Vec<[f32; 4]> {
     v
 }
 
-fn median(mut t: Vec<Duration>) -> Duration {
-    t.sort();
-    t[t.len() / 2]
-}
-
-/// Median time of `f` over [`REPEATS`] runs after one warm-up (also the `vdt` section's).
-pub(super) fn time(mut f: impl FnMut()) -> Duration {
-    f();
-    median(
-        (0..REPEATS)
-            .map(|_| {
-                let t = Instant::now();
-                f();
-                t.elapsed()
-            })
-            .collect(),
-    )
-}
-
 /// Per-option error statistics, in f32 ulps of each box's exact value.
 #[derive(Clone, Debug, serde::Serialize)]
-struct ErrRow {
-    option: &'static str,
-    side: usize,
-    bytes: usize,
-    max_ulps: f64,
-    mean_ulps: f64,
+pub struct ErrRow {
+    /// Storage option.
+    pub option: &'static str,
+    /// Table side.
+    pub side: usize,
+    /// Bytes of the table.
+    pub bytes: usize,
+    /// Largest error.
+    pub max_ulps: f64,
+    /// Mean error.
+    pub mean_ulps: f64,
     /// |error| on the 16×16 box next to the far corner.
-    far_box_abs: f64,
+    pub far_box_abs: f64,
 }
 
 fn options(g: &Grid) -> Result<Vec<Box<dyn Storage>>, Box<dyn Error>> {
@@ -108,72 +98,79 @@ fn options(g: &Grid) -> Result<Vec<Box<dyn Storage>>, Box<dyn Error>> {
     ])
 }
 
-fn svg_growth(rows: &[ErrRow], names: &[&'static str]) -> String {
-    let (w, h, l, b) = (560.0, 300.0, 60.0, 40.0);
-    let x = |side: usize| l + ((side as f64).log2() - 6.0) / 5.0 * (w - l - 20.0);
-    let y = |ulps: f64| {
-        let lg = ulps.max(0.01).log10().clamp(-2.0, 6.0);
-        (h - b) - (lg + 2.0) / 8.0 * (h - b - 10.0)
-    };
-    let colors = [
-        "#d62728", "#ff7f0e", "#9467bd", "#8c564b", "#1f77b4", "#2ca02c",
-    ];
-    let mut s = format!(
-        r#"<svg xmlns="http://www.w3.org/2000/svg" width="{w}" height="{h}" font-size="11">"#
-    );
-    for k in -2..=6 {
-        let yy = y(10f64.powi(k));
-        let _ = write!(
-            s,
-            r##"<line x1="{l}" x2="{}" y1="{yy}" y2="{yy}" stroke="#ddd"/><text x="4" y="{}">1e{k}</text>"##,
-            w - 20.0,
-            yy + 4.0
-        );
-    }
-    for side in SIDES {
-        let _ = write!(
-            s,
-            r#"<text x="{}" y="{}">{side}²</text>"#,
-            x(side) - 12.0,
-            h - 20.0
-        );
-    }
-    let _ = write!(
-        s,
-        r#"<text x="{l}" y="{}">max error, f32 ulps of the box (log)</text>"#,
-        h - 4.0
-    );
-    for (k, name) in names.iter().enumerate() {
-        let pts: Vec<String> = rows
-            .iter()
-            .filter(|r| r.option == *name)
-            .map(|r| format!("{:.1},{:.1}", x(r.side), y(r.max_ulps)))
-            .collect();
-        let c = colors[k % colors.len()];
-        let _ = write!(
-            s,
-            r#"<polyline fill="none" stroke="{c}" stroke-width="2" points="{}"/><text x="{}" y="{}" fill="{c}">{name}</text>"#,
-            pts.join(" "),
-            l + 10.0,
-            14.0 + 13.0 * k as f64
-        );
-    }
-    s.push_str("</svg>");
-    s
+/// Median times of the speed measurements at [`SIDE`]².
+#[derive(Clone, Debug)]
+pub struct SatTimes {
+    /// Build, ours (i64).
+    pub build_ours: Duration,
+    /// Build, plain f32.
+    pub build_f32: Duration,
+    /// Build, f64.
+    pub build_f64: Duration,
+    /// Fractional queries, ours, scalar.
+    pub scalar: Duration,
+    /// Fractional queries, ours, SIMD.
+    pub simd: Duration,
+    /// Fractional queries, plain f32.
+    pub f32: Duration,
+    /// Fractional queries, f64.
+    pub f64: Duration,
+    /// Integer queries, plain f32 (4 lookups).
+    pub int_f32: Duration,
+    /// Integer queries, ours (`box_sum_cells`).
+    pub int_ours: Duration,
+    /// Warm fractional queries, scalar.
+    pub warm_scalar: Duration,
+    /// Warm fractional queries, SIMD.
+    pub warm_simd: Duration,
+    /// Warm integer queries, plain f32.
+    pub warm_f32_int: Duration,
+    /// Warm integer queries, ours.
+    pub warm_int: Duration,
 }
 
-/// The section.
-pub fn section(opts: &Options) -> Result<Section, Box<dyn Error>> {
-    let bar = ProgressBar::new((SIDES.len() + 4) as u64).with_style(
-        ProgressStyle::with_template("{spinner} [{elapsed_precise}] {bar:30} {pos}/{len} {msg}")
-            .unwrap_or_else(|_| ProgressStyle::default_bar()),
-    );
+/// The wgpu measurements.
+#[derive(Clone, Debug)]
+pub struct SatGpu {
+    /// The adapter, or why there is none.
+    pub note: String,
+    /// Median time of the timed queries, upload and read-back included.
+    pub time: Option<Duration>,
+    /// Largest error in ulps against f64 over the checked boxes.
+    pub max_ulps: Option<f64>,
+    /// Largest |gpu − cpu| relative to the absolute sum read.
+    pub max_rel_vs_cpu: Option<f64>,
+}
 
-    // 1. Error growth with resolution, per storage option.
+/// Everything the section measures.
+#[derive(Clone, Debug)]
+pub struct SatResults {
+    /// Error per storage option and side.
+    pub rows: Vec<ErrRow>,
+    /// Storage options, in table order.
+    pub names: Vec<&'static str>,
+    /// Queries per timed run.
+    pub queries: usize,
+    /// Distinct queries of the warm runs.
+    pub warm: usize,
+    /// Queries per warm timed run (`warm` repeated).
+    pub warm_total: usize,
+    /// Timed repeats.
+    pub repeats: usize,
+    /// Median times.
+    pub times: SatTimes,
+    /// Whether SIMD agrees bit for bit with the scalar query.
+    pub simd_bit_exact: bool,
+    /// wgpu.
+    pub gpu: SatGpu,
+    /// Worst error over its stated bound on the high-dynamic-range grid.
+    pub hdr_worst_of_bound: f64,
+}
+
+/// Error growth with resolution, per storage option.
+fn error_growth() -> Result<Vec<ErrRow>, Box<dyn Error>> {
     let mut rows = Vec::new();
-    let mut names = Vec::new();
     for (si, &n) in SIDES.iter().enumerate() {
-        bar.set_message(format!("SAT error at {n}²"));
         let g = uniform_grid(n, SEED + si as u64);
         let boxes = random_boxes(n, ERROR_BOXES, SEED ^ n as u64);
         let refs: Vec<f64> = boxes
@@ -193,9 +190,6 @@ pub fn section(opts: &Options) -> Result<Section, Box<dyn Error>> {
                     far = (got - r).abs();
                 }
             }
-            if si == 0 {
-                names.push(opt.name());
-            }
             rows.push(ErrRow {
                 option: opt.name(),
                 side: n,
@@ -205,20 +199,126 @@ pub fn section(opts: &Options) -> Result<Section, Box<dyn Error>> {
                 far_box_abs: far,
             });
         }
-        bar.inc(1);
     }
+    Ok(rows)
+}
+
+/// The wgpu queries on `view` of `g`: timed on `cols`, checked on the first
+/// [`GPU_CHECKED`] boxes of the timed queries' seed against f64 and the CPU.
+fn gpu_queries(
+    opts: &Options,
+    g: &Grid,
+    view: &steradian_core::rsl::sat::SatView<'_>,
+    cols: &Columns,
+) -> SatGpu {
+    let mut r = SatGpu {
+        note: String::from("not tried"),
+        time: None,
+        max_ulps: None,
+        max_rel_vs_cpu: None,
+    };
+    if !opts.gpu {
+        return r;
+    }
+    let mut gpu = match try_gpu() {
+        Err(why) => {
+            r.note = format!("none ({why})");
+            return r;
+        }
+        Ok(gpu) => gpu,
+    };
+    r.note = gpu.adapter_info();
+    let table = gpu_table(view);
+    let mut gout = Columns::zeros(1, cols.n);
+    let mut fail = None;
+    let t = median_time(opts.repeats, || {
+        if let Err(e) = gpu_box_sums(&mut gpu, &table, cols, &mut gout) {
+            fail = Some(e.to_string());
+        }
+    });
+    let check = &random_boxes(SIDE, GPU_CHECKED, SEED + 99)[..GPU_CHECKED];
+    let mut cout = Columns::zeros(1, check.len());
+    if fail.is_none()
+        && let Err(e) = gpu_box_sums(&mut gpu, &table, &Columns::from_rows(check), &mut cout)
+    {
+        fail = Some(e.to_string());
+    }
+    match fail {
+        Some(e) => r.note = format!("{}: failed: {e}", r.note),
+        None => {
+            r.time = Some(t);
+            let mut worst: f64 = 0.0;
+            let mut worst_rel: f64 = 0.0;
+            for (k, q) in check.iter().enumerate() {
+                let reference = g.reference(q[0], q[1], q[2], q[3]);
+                let got = cout.data[k] as f64;
+                let cpu = view.box_sum(q[0], q[1], q[2], q[3]) as f64;
+                worst = worst.max((got - reference.value).abs() / ulp(reference.value));
+                worst_rel = worst_rel.max((got - cpu).abs() / reference.abs_read.max(1e-300));
+            }
+            r.max_ulps = Some(worst);
+            r.max_rel_vs_cpu = Some(worst_rel);
+        }
+    }
+    r
+}
+
+/// Worst error over the stated bound of ours at [`SIDE`]² on a grid with a huge dynamic
+/// range (log-uniform magnitudes 1e-6 … 1e6, mixed signs): the bound, not ulps, is the
+/// promise there.
+fn hdr_worst_of_bound() -> Result<f64, Box<dyn Error>> {
+    let n = SIDE;
+    let mut rng = Rng::new(SEED + 7);
+    let hdr = Grid {
+        width: n,
+        height: n,
+        texels: (0..n * n)
+            .map(|_| {
+                let m = rng.log_range(1e-6, 1e6);
+                (if rng.unit() < 0.3 { -m } else { m }) as f32
+            })
+            .collect(),
+    };
+    let hsat = Sat::build(n, n, &hdr.texels)?;
+    let t_abs = hdr.abs_sum();
+    let mut worst: f64 = 0.0;
+    for b in random_boxes(n, 1000, SEED + 8) {
+        let r = hdr.reference(b[0], b[1], b[2], b[3]);
+        let got = hsat.box_sum(b[0], b[1], b[2], b[3]) as f64;
+        worst = worst.max((got - r.value).abs() / crate::sat::error_bound(&r, t_abs));
+    }
+    Ok(worst)
+}
+
+/// Runs the section's measurements.
+pub fn measure(opts: &Options) -> Result<SatResults, Box<dyn Error>> {
+    let bar = ProgressBar::new(5).with_style(
+        ProgressStyle::with_template("{spinner} [{elapsed_precise}] {bar:30} {pos}/{len} {msg}")
+            .unwrap_or_else(|_| ProgressStyle::default_bar()),
+    );
+
+    // 1. Error growth with resolution, per storage option.
+    bar.set_message(format!("SAT error at {SIDES:?}²"));
+    let rows = error_growth()?;
+    let names = rows
+        .iter()
+        .filter(|r| r.side == SIDES[0])
+        .map(|r| r.option)
+        .collect();
+    bar.inc(1);
 
     // 2. Build time and query throughput at 1024².
-    let n = 1024;
+    let n = SIDE;
+    let reps = opts.repeats;
     bar.set_message("SAT build times at 1024²");
     let g = uniform_grid(n, SEED + 4);
-    let t_build_ours = time(|| {
+    let build_ours = median_time(reps, || {
         black_box(Sat::build(n, n, black_box(&g.texels)).ok());
     });
-    let t_build_f32 = time(|| {
+    let build_f32 = median_time(reps, || {
         black_box(PlainF32::build(black_box(&g)));
     });
-    let t_build_f64 = time(|| {
+    let build_f64 = median_time(reps, || {
         black_box(PlainF64::build(black_box(&g)));
     });
     bar.inc(1);
@@ -228,19 +328,20 @@ pub fn section(opts: &Options) -> Result<Section, Box<dyn Error>> {
     let view = sat.view();
     let plain = PlainF32::build(&g);
     let f64s = PlainF64::build(&g);
-    let qs = random_boxes(n, QUERIES, SEED + 99);
-    let qs = &qs[..QUERIES];
+    let queries = opts.scaled(QUERIES);
+    let qs = random_boxes(n, queries, SEED + 99);
+    let qs = &qs[..queries];
     let cols = Columns::from_rows(qs);
-    let mut out = vec![0.0f32; QUERIES];
-    let t_scalar = time(|| {
+    let mut out = vec![0.0f32; queries];
+    let scalar = median_time(reps, || {
         for (o, q) in out.iter_mut().zip(qs) {
             *o = view.box_sum(q[0], q[1], q[2], q[3]);
         }
         black_box(&out);
     });
     let scalar_out = out.clone();
-    let mut simd_out = vec![0.0f32; QUERIES];
-    let t_simd = time(|| {
+    let mut simd_out = vec![0.0f32; queries];
+    let simd = median_time(reps, || {
         steradian_simd::rsl::sat::box_sum_slices(
             &view,
             cols.col(0),
@@ -255,13 +356,13 @@ pub fn section(opts: &Options) -> Result<Section, Box<dyn Error>> {
         .iter()
         .zip(&simd_out)
         .all(|(a, b)| a.to_bits() == b.to_bits());
-    let t_f32 = time(|| {
+    let f32_t = median_time(reps, || {
         for (o, q) in out.iter_mut().zip(qs) {
             *o = plain.box_sum_f32(q[0], q[1], q[2], q[3]);
         }
         black_box(&out);
     });
-    let t_f64 = time(|| {
+    let f64_t = median_time(reps, || {
         for (o, q) in out.iter_mut().zip(qs) {
             *o = f64s.box_sum(q[0], q[1], q[2], q[3]) as f32;
         }
@@ -270,34 +371,35 @@ pub fn section(opts: &Options) -> Result<Section, Box<dyn Error>> {
     // Integer corners: the peers' four-lookup query against ours (`box_sum_cells`, the
     // same `usize` corners) on the same boxes.
     let iq: Vec<[usize; 4]> = qs.iter().map(|q| q.map(|c| (c as usize).min(n))).collect();
-    let t_int_f32 = time(|| {
+    let int_f32 = median_time(reps, || {
         for (o, q) in out.iter_mut().zip(&iq) {
             *o = plain.box_sum_int(q[0], q[1], q[2], q[3]);
         }
         black_box(&out);
     });
-    let t_int_ours = time(|| {
+    let int_ours = median_time(reps, || {
         for (o, q) in out.iter_mut().zip(&iq) {
             *o = view.box_sum_cells(q[0], q[1], q[2], q[3]);
         }
         black_box(&out);
     });
-    // Warm: the first WARM queries, repeated (the table lines they touch stay in cache):
+    // Warm: the first `warm` queries, repeated (the table lines they touch stay in cache):
     // the arithmetic alone, where the cold runs above are bound by memory latency.
-    let warm = &qs[..WARM];
+    let warm_n = WARM.min(queries);
+    let rounds = (queries / warm_n).max(1);
+    let warm = &qs[..warm_n];
     let wc = Columns::from_rows(warm);
-    let mut wout = vec![0.0f32; WARM];
-    let reps = QUERIES / WARM;
-    let t_warm_scalar = time(|| {
-        for _ in 0..reps {
+    let mut wout = vec![0.0f32; warm_n];
+    let warm_scalar = median_time(reps, || {
+        for _ in 0..rounds {
             for (o, q) in wout.iter_mut().zip(warm) {
                 *o = view.box_sum(q[0], q[1], q[2], q[3]);
             }
             black_box(&wout);
         }
     });
-    let t_warm_simd = time(|| {
-        for _ in 0..reps {
+    let warm_simd = median_time(reps, || {
+        for _ in 0..rounds {
             steradian_simd::rsl::sat::box_sum_slices(
                 &view,
                 wc.col(0),
@@ -309,17 +411,17 @@ pub fn section(opts: &Options) -> Result<Section, Box<dyn Error>> {
             black_box(&wout);
         }
     });
-    let t_warm_f32_int = time(|| {
-        for _ in 0..reps {
-            for (o, q) in wout.iter_mut().zip(&iq[..WARM]) {
+    let warm_f32_int = median_time(reps, || {
+        for _ in 0..rounds {
+            for (o, q) in wout.iter_mut().zip(&iq[..warm_n]) {
                 *o = plain.box_sum_int(q[0], q[1], q[2], q[3]);
             }
             black_box(&wout);
         }
     });
-    let t_warm_int = time(|| {
-        for _ in 0..reps {
-            for (o, q) in wout.iter_mut().zip(&iq[..WARM]) {
+    let warm_int = median_time(reps, || {
+        for _ in 0..rounds {
+            for (o, q) in wout.iter_mut().zip(&iq[..warm_n]) {
                 *o = view.box_sum_cells(q[0], q[1], q[2], q[3]);
             }
             black_box(&wout);
@@ -329,146 +431,154 @@ pub fn section(opts: &Options) -> Result<Section, Box<dyn Error>> {
 
     // 3. GPU.
     bar.set_message("SAT on the GPU");
-    let mut gpu_note = String::from("not tried");
-    let mut t_gpu = None;
-    let mut gpu_err_ulps = None;
-    let mut gpu_vs_cpu_rel = None;
-    if opts.gpu {
-        match try_gpu() {
-            Err(why) => gpu_note = format!("none ({why})"),
-            Ok(mut gpu) => {
-                gpu_note = gpu.adapter_info();
-                let table = gpu_table(&view);
-                let mut gout = Columns::zeros(1, QUERIES);
-                let mut fail = None;
-                let t = time(|| {
-                    if let Err(e) = gpu_box_sums(&mut gpu, &table, &cols, &mut gout) {
-                        fail = Some(e.to_string());
-                    }
-                });
-                match fail {
-                    Some(e) => gpu_note = format!("{gpu_note}: failed: {e}"),
-                    None => {
-                        t_gpu = Some(t);
-                        let mut worst: f64 = 0.0;
-                        let mut worst_rel: f64 = 0.0;
-                        for (k, q) in qs.iter().enumerate().take(4000) {
-                            let r = g.reference(q[0], q[1], q[2], q[3]);
-                            let got = gout.data[k] as f64;
-                            worst = worst.max((got - r.value).abs() / ulp(r.value));
-                            worst_rel = worst_rel
-                                .max((got - scalar_out[k] as f64).abs() / r.abs_read.max(1e-300));
-                        }
-                        gpu_err_ulps = Some(worst);
-                        gpu_vs_cpu_rel = Some(worst_rel);
-                    }
-                }
-            }
-        }
-    }
+    let gpu = gpu_queries(opts, &g, &view, &cols);
     bar.inc(1);
 
-    // 4. Error of ours at 1024² on a grid with a huge dynamic range (log-uniform
-    // magnitudes 1e-6 … 1e6, mixed signs): the bound, not ulps, is the promise there.
+    // 4. The stated bound on a high-dynamic-range grid.
     bar.set_message("SAT error on a high-dynamic-range grid");
-    let mut rng = Rng::new(SEED + 7);
-    let hdr = Grid {
-        width: n,
-        height: n,
-        texels: (0..n * n)
-            .map(|_| {
-                let m = rng.log_range(1e-6, 1e6);
-                (if rng.unit() < 0.3 { -m } else { m }) as f32
-            })
-            .collect(),
-    };
-    let hsat = Sat::build(n, n, &hdr.texels)?;
-    let t_abs = hdr.abs_sum();
-    let mut hdr_worst_of_bound: f64 = 0.0;
-    for b in random_boxes(n, 1000, SEED + 8) {
-        let r = hdr.reference(b[0], b[1], b[2], b[3]);
-        let got = hsat.box_sum(b[0], b[1], b[2], b[3]) as f64;
-        hdr_worst_of_bound =
-            hdr_worst_of_bound.max((got - r.value).abs() / crate::sat::error_bound(&r, t_abs));
-    }
+    let hdr_worst_of_bound = hdr_worst_of_bound()?;
     bar.inc(1);
     bar.finish_and_clear();
 
-    // Text and HTML.
-    let ns = |d: Duration| d.as_secs_f64() * 1e9 / QUERIES as f64;
-    let ms = |d: Duration| d.as_secs_f64() * 1e3;
-    let at = |side: usize, name: &str| rows.iter().find(|r| r.side == side && r.option == name);
+    Ok(SatResults {
+        rows,
+        names,
+        queries,
+        warm: warm_n,
+        warm_total: warm_n * rounds,
+        repeats: reps,
+        times: SatTimes {
+            build_ours,
+            build_f32,
+            build_f64,
+            scalar,
+            simd,
+            f32: f32_t,
+            f64: f64_t,
+            int_f32,
+            int_ours,
+            warm_scalar,
+            warm_simd,
+            warm_f32_int,
+            warm_int,
+        },
+        simd_bit_exact,
+        gpu,
+        hdr_worst_of_bound,
+    })
+}
+
+/// Milliseconds of `d`.
+fn ms(d: Duration) -> f64 {
+    d.as_secs_f64() * 1e3
+}
+
+/// `a / b` of two durations.
+fn ratio(a: Duration, b: Duration) -> f64 {
+    a.as_secs_f64() / b.as_secs_f64()
+}
+
+impl SatResults {
+    /// Nanoseconds per query of a cold timed run.
+    fn ns(&self, d: Duration) -> f64 {
+        ns_per(self.queries, d)
+    }
+
+    /// Nanoseconds per query of a warm timed run.
+    fn warm_ns(&self, d: Duration) -> f64 {
+        ns_per(self.warm_total, d)
+    }
+
+    /// The error row of option `name` at `side`.
+    fn at(&self, side: usize, name: &str) -> Option<&ErrRow> {
+        self.rows
+            .iter()
+            .find(|r| r.side == side && r.option == name)
+    }
+}
+
+/// The summary text of the section.
+fn summary(r: &SatResults) -> String {
+    let (t, n) = (&r.times, SIDE);
     let mut summary = String::new();
     let _ = writeln!(
         summary,
         "SAT, 1024² texels in [0,1), {} random fractional boxes (sides 0.5–64) + the 16×16 box at the far corner:",
         ERROR_BOXES
     );
-    for name in &names {
-        if let Some(r) = at(1024, name) {
+    for name in &r.names {
+        if let Some(e) = r.at(1024, name) {
             let _ = writeln!(
                 summary,
                 "  {:<32} max {:>10.3} ulps, mean {:>9.3} ulps, far 16×16 box off by {:.3e}, {:.1} bytes/texel",
                 name,
-                r.max_ulps,
-                r.mean_ulps,
-                r.far_box_abs,
-                r.bytes as f64 / (n * n) as f64
+                e.max_ulps,
+                e.mean_ulps,
+                e.far_box_abs,
+                e.bytes as f64 / (n * n) as f64
             );
         }
     }
     let _ = writeln!(
         summary,
         "  build 1024²: ours {:.2} ms, plain f32 {:.2} ms ({:.2}×), f64 {:.2} ms",
-        ms(t_build_ours),
-        ms(t_build_f32),
-        t_build_ours.as_secs_f64() / t_build_f32.as_secs_f64(),
-        ms(t_build_f64)
+        ms(t.build_ours),
+        ms(t.build_f32),
+        ratio(t.build_ours, t.build_f32),
+        ms(t.build_f64)
     );
     let _ = writeln!(
         summary,
         "  query (fractional corners) ns/query: scalar {:.2}, SIMD {:.2} ({:.2}× scalar, bit-exact: {}), plain f32 {:.2}, f64 {:.2}{}",
-        ns(t_scalar),
-        ns(t_simd),
-        t_scalar.as_secs_f64() / t_simd.as_secs_f64(),
-        simd_bit_exact,
-        ns(t_f32),
-        ns(t_f64),
-        t_gpu.map_or(String::new(), |t| format!(
+        r.ns(t.scalar),
+        r.ns(t.simd),
+        ratio(t.scalar, t.simd),
+        r.simd_bit_exact,
+        r.ns(t.f32),
+        r.ns(t.f64),
+        r.gpu.time.map_or(String::new(), |g| format!(
             ", wgpu {:.2} (round trip)",
-            ns(t)
+            r.ns(g)
         ))
     );
     let _ = writeln!(
         summary,
         "  query (integer corners) ns/query: ours (box_sum_cells) {:.2}, plain f32 4-lookup {:.2} ({:.2}×)",
-        ns(t_int_ours),
-        ns(t_int_f32),
-        t_int_ours.as_secs_f64() / t_int_f32.as_secs_f64()
+        r.ns(t.int_ours),
+        r.ns(t.int_f32),
+        ratio(t.int_ours, t.int_f32)
     );
     let _ = writeln!(
         summary,
-        "  warm ({WARM} queries repeated, in cache) ns/query: fractional scalar {:.2}, SIMD {:.2} ({:.2}× scalar); integer ours {:.2}, plain f32 4-lookup {:.2}",
-        ns(t_warm_scalar),
-        ns(t_warm_simd),
-        t_warm_scalar.as_secs_f64() / t_warm_simd.as_secs_f64(),
-        ns(t_warm_int),
-        ns(t_warm_f32_int)
+        "  warm ({} queries repeated, in cache) ns/query: fractional scalar {:.2}, SIMD {:.2} ({:.2}× scalar); integer ours {:.2}, plain f32 4-lookup {:.2}",
+        r.warm,
+        r.warm_ns(t.warm_scalar),
+        r.warm_ns(t.warm_simd),
+        ratio(t.warm_scalar, t.warm_simd),
+        r.warm_ns(t.warm_int),
+        r.warm_ns(t.warm_f32_int)
     );
-    if let (Some(e), Some(rel)) = (gpu_err_ulps, gpu_vs_cpu_rel) {
+    if let (Some(e), Some(rel)) = (r.gpu.max_ulps, r.gpu.max_rel_vs_cpu) {
         let _ = writeln!(
             summary,
-            "  wgpu ({gpu_note}): max {e:.2} ulps vs f64; |gpu − cpu| ≤ {rel:.2e}·A (tolerance {:.1e})",
+            "  wgpu ({}): max {e:.2} ulps vs f64; |gpu − cpu| ≤ {rel:.2e}·A (tolerance {:.1e})",
+            r.gpu.note,
             steradian_core::wgsl::SAT_BOX_REL_TOL
         );
     } else {
-        let _ = writeln!(summary, "  wgpu: {gpu_note}");
+        let _ = writeln!(summary, "  wgpu: {}", r.gpu.note);
     }
     let _ = writeln!(
         summary,
-        "  high-dynamic-range grid (|t| in 1e-6…1e6, mixed signs): worst error / stated bound = {hdr_worst_of_bound:.3}"
+        "  high-dynamic-range grid (|t| in 1e-6…1e6, mixed signs): worst error / stated bound = {:.3}",
+        r.hdr_worst_of_bound
     );
+    summary
+}
 
+/// The HTML of the section.
+fn html(r: &SatResults) -> String {
+    let (t, n) = (&r.times, SIDE);
     let mut html = String::new();
     let _ = write!(
         html,
@@ -482,98 +592,160 @@ pub fn section(opts: &Options) -> Result<Section, Box<dyn Error>> {
         let _ = write!(html, "<th>max ulps {s}²</th>");
     }
     html.push_str("<th>far 16×16 box |err| at 1024²</th></tr>");
-    for name in &names {
+    for name in &r.names {
         let _ = write!(html, "<tr><td>{name}</td>");
-        let b = at(1024, name).map_or(0.0, |r| r.bytes as f64 / (n * n) as f64);
+        let b = r
+            .at(1024, name)
+            .map_or(0.0, |e| e.bytes as f64 / (n * n) as f64);
         let _ = write!(html, "<td>{b:.2}</td>");
         for s in SIDES {
-            let v = at(s, name).map_or(f64::NAN, |r| r.max_ulps);
+            let v = r.at(s, name).map_or(f64::NAN, |e| e.max_ulps);
             let _ = write!(html, "<td>{v:.3}</td>");
         }
-        let far = at(1024, name).map_or(f64::NAN, |r| r.far_box_abs);
+        let far = r.at(1024, name).map_or(f64::NAN, |e| e.far_box_abs);
         let _ = write!(html, "<td>{far:.3e}</td></tr>");
     }
     html.push_str("</table>");
-    html.push_str(&svg_growth(&rows, &names));
+    html.push_str(&plot(r));
     let _ = write!(
         html,
-        "<h3>Speed at 1024² ({QUERIES} queries, median of {REPEATS})</h3><table>\
+        "<h3>Speed at 1024² ({} queries, median of {})</h3><table>\
          <tr><th>what</th><th>ns per query / build ms</th><th>ratio</th></tr>\
          <tr><td>build, ours (i64)</td><td>{:.2} ms</td><td>{:.2}× plain f32</td></tr>\
          <tr><td>build, plain f32</td><td>{:.2} ms</td><td>1</td></tr>\
          <tr><td>build, f64</td><td>{:.2} ms</td><td>{:.2}×</td></tr>\
          <tr><td>fractional query, scalar</td><td>{:.2} ns</td><td>1</td></tr>\
-         <tr><td>fractional query, SIMD ({})</td><td>{:.2} ns</td><td>{:.2}× faster (bit-exact: {simd_bit_exact})</td></tr>\
+         <tr><td>fractional query, SIMD ({})</td><td>{:.2} ns</td><td>{:.2}× faster (bit-exact: {})</td></tr>\
          <tr><td>fractional query, plain f32 (4 bilinear corners)</td><td>{:.2} ns</td><td>{:.2}× ours</td></tr>\
          <tr><td>fractional query, f64 (4 bilinear corners)</td><td>{:.2} ns</td><td>{:.2}× ours</td></tr>\
          <tr><td>integer query, ours</td><td>{:.2} ns</td><td>1</td></tr>\
          <tr><td>integer query, plain f32 (4 lookups)</td><td>{:.2} ns</td><td>{:.2}× ours</td></tr>",
-        ms(t_build_ours),
-        t_build_ours.as_secs_f64() / t_build_f32.as_secs_f64(),
-        ms(t_build_f32),
-        ms(t_build_f64),
-        t_build_f64.as_secs_f64() / t_build_f32.as_secs_f64(),
-        ns(t_scalar),
+        r.queries,
+        r.repeats,
+        ms(t.build_ours),
+        ratio(t.build_ours, t.build_f32),
+        ms(t.build_f32),
+        ms(t.build_f64),
+        ratio(t.build_f64, t.build_f32),
+        r.ns(t.scalar),
         steradian_simd::isa(),
-        ns(t_simd),
-        t_scalar.as_secs_f64() / t_simd.as_secs_f64(),
-        ns(t_f32),
-        t_f32.as_secs_f64() / t_scalar.as_secs_f64(),
-        ns(t_f64),
-        t_f64.as_secs_f64() / t_scalar.as_secs_f64(),
-        ns(t_int_ours),
-        ns(t_int_f32),
-        t_int_f32.as_secs_f64() / t_int_ours.as_secs_f64(),
+        r.ns(t.simd),
+        ratio(t.scalar, t.simd),
+        r.simd_bit_exact,
+        r.ns(t.f32),
+        ratio(t.f32, t.scalar),
+        r.ns(t.f64),
+        ratio(t.f64, t.scalar),
+        r.ns(t.int_ours),
+        r.ns(t.int_f32),
+        ratio(t.int_f32, t.int_ours),
     );
-    if let Some(t) = t_gpu {
+    let note = &r.gpu.note;
+    if let Some(g) = r.gpu.time {
         let _ = write!(
             html,
-            "<tr><td>fractional query, wgpu ({gpu_note}), upload + read-back included</td><td>{:.2} ns</td><td>{:.2}× scalar</td></tr>",
-            ns(t),
-            t.as_secs_f64() / t_scalar.as_secs_f64()
+            "<tr><td>fractional query, wgpu ({note}), upload + read-back included</td><td>{:.2} ns</td><td>{:.2}× scalar</td></tr>",
+            r.ns(g),
+            ratio(g, t.scalar)
         );
     } else {
-        let _ = write!(html, "<tr><td>wgpu</td><td colspan=2>{gpu_note}</td></tr>");
+        let _ = write!(html, "<tr><td>wgpu</td><td colspan=2>{note}</td></tr>");
     }
     let _ = write!(
         html,
-        "<tr><td>warm: fractional query, scalar ({WARM} queries repeated)</td><td>{:.2} ns</td><td>1</td></tr>\
+        "<tr><td>warm: fractional query, scalar ({} queries repeated)</td><td>{:.2} ns</td><td>1</td></tr>\
          <tr><td>warm: fractional query, SIMD</td><td>{:.2} ns</td><td>{:.2}× faster</td></tr>\
          <tr><td>warm: integer query, ours</td><td>{:.2} ns</td><td>1</td></tr>\
          <tr><td>warm: integer query, plain f32 (4 lookups)</td><td>{:.2} ns</td><td>{:.2}× ours</td></tr>",
-        ns(t_warm_scalar),
-        ns(t_warm_simd),
-        t_warm_scalar.as_secs_f64() / t_warm_simd.as_secs_f64(),
-        ns(t_warm_int),
-        ns(t_warm_f32_int),
-        t_warm_f32_int.as_secs_f64() / t_warm_int.as_secs_f64(),
+        r.warm,
+        r.warm_ns(t.warm_scalar),
+        r.warm_ns(t.warm_simd),
+        ratio(t.warm_scalar, t.warm_simd),
+        r.warm_ns(t.warm_int),
+        r.warm_ns(t.warm_f32_int),
+        ratio(t.warm_f32_int, t.warm_int),
     );
-    html.push_str(
-        "</table><p>Cold rows: 2¹⁸ random boxes over the 8 MB table, bound by memory \
+    let _ = write!(
+        html,
+        "</table><p>Cold rows: {} random boxes over the 8 MB table, bound by memory \
         latency (a query reads 8 cache lines in 4 rows where a plain integer query reads 4, and \
         its ~200 instructions leave fewer misses in flight). Warm rows: the arithmetic.</p>",
+        power_of_two(r.queries)
     );
+    html
+}
 
-    let data = json!({
-        "error_growth": rows,
-        "build_ms": {"ours": ms(t_build_ours), "plain_f32": ms(t_build_f32), "f64": ms(t_build_f64)},
+/// `n` as a power of two with a superscript exponent (`2¹⁸`) where it is one, else in digits.
+fn power_of_two(n: usize) -> String {
+    if !n.is_power_of_two() {
+        return n.to_string();
+    }
+    const SUPERSCRIPTS: [char; 10] = ['⁰', '¹', '²', '³', '⁴', '⁵', '⁶', '⁷', '⁸', '⁹'];
+    let exponent = n.trailing_zeros().to_string();
+    let digits = exponent.bytes().map(|d| SUPERSCRIPTS[(d - b'0') as usize]);
+    std::iter::once('2').chain(digits).collect()
+}
+
+/// The data of the section in `report.json`.
+fn data(r: &SatResults) -> serde_json::Value {
+    let t = &r.times;
+    let warm = |d| r.warm_ns(d);
+    json!({
+        "error_growth": r.rows,
+        "build_ms": {"ours": ms(t.build_ours), "plain_f32": ms(t.build_f32), "f64": ms(t.build_f64)},
         "query_ns": {
-            "scalar": ns(t_scalar), "simd": ns(t_simd), "plain_f32": ns(t_f32), "f64": ns(t_f64),
-            "wgpu": t_gpu.map(ns),
-            "integer_ours": ns(t_int_ours), "integer_plain_f32": ns(t_int_f32),
-            "warm_scalar": ns(t_warm_scalar), "warm_simd": ns(t_warm_simd),
-            "warm_integer_ours": ns(t_warm_int), "warm_integer_plain_f32": ns(t_warm_f32_int),
+            "scalar": r.ns(t.scalar), "simd": r.ns(t.simd), "plain_f32": r.ns(t.f32), "f64": r.ns(t.f64),
+            "wgpu": r.gpu.time.map(|g| r.ns(g)),
+            "integer_ours": r.ns(t.int_ours), "integer_plain_f32": r.ns(t.int_f32),
+            "warm_scalar": warm(t.warm_scalar), "warm_simd": warm(t.warm_simd),
+            "warm_integer_ours": warm(t.warm_int), "warm_integer_plain_f32": warm(t.warm_f32_int),
         },
-        "simd_bit_exact": simd_bit_exact,
-        "gpu": {"adapter": gpu_note, "max_ulps_vs_f64": gpu_err_ulps, "max_rel_to_A_vs_cpu": gpu_vs_cpu_rel},
-        "hdr_worst_error_over_bound": hdr_worst_of_bound,
-    });
-    Ok(Section {
+        "simd_bit_exact": r.simd_bit_exact,
+        "gpu": {"adapter": r.gpu.note, "max_ulps_vs_f64": r.gpu.max_ulps, "max_rel_to_A_vs_cpu": r.gpu.max_rel_vs_cpu},
+        "hdr_worst_error_over_bound": r.hdr_worst_of_bound,
+    })
+}
+
+/// Max error (log, clamped to 1e-2 … 1e6 ulps) against the table side, a line per option.
+fn plot(r: &SatResults) -> String {
+    let series = r
+        .names
+        .iter()
+        .map(|name| {
+            let points = r
+                .rows
+                .iter()
+                .filter(|e| e.option == *name)
+                .map(|e| Pt::new(e.side as f64, e.max_ulps.clamp(1e-2, 1e6)))
+                .collect();
+            Series::line(*name, points)
+        })
+        .collect();
+    let ticks = SIDES.iter().map(|&s| (s as f64, format!("{s}²"))).collect();
+    Chart::new(
+        "Summed-area tables: max error against resolution",
+        Axis::new("table size (texels)", Scale::Log)
+            .range(SIDES[0] as f64, SIDES[SIDES.len() - 1] as f64)
+            .ticks(ticks),
+        Axis::new("max error, f32 ulps of the box (log)", Scale::Log).range(1e-2, 1e6),
+        series,
+    )
+    .svg()
+}
+
+/// The section of measured results.
+pub fn render(r: &SatResults) -> Section {
+    Section {
         id: "sat",
         title: "Summed-area tables".into(),
-        summary,
-        html,
-        data,
+        summary: summary(r),
+        html: html(r),
+        data: data(r),
         files: Vec::new(),
-    })
+    }
+}
+
+/// The section.
+pub fn section(opts: &Options) -> Result<Section, Box<dyn Error>> {
+    Ok(render(&measure(opts)?))
 }

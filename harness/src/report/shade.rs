@@ -6,7 +6,7 @@
 use std::error::Error;
 use std::fmt::Write as _;
 use std::hint::black_box;
-use std::time::{Duration, Instant};
+use std::time::Duration;
 
 use indicatif::{ProgressBar, ProgressStyle};
 use serde_json::json;
@@ -15,6 +15,7 @@ use steradian_core::rsl::shade::{self, ShadeLight, VdtQuery, VdtVisibility};
 
 use super::Options;
 use super::section::Section;
+use super::timing::{median_time_for, per_second};
 use crate::backend::gpu::{Custom, try_gpu};
 use crate::env::decompose::{Decomposition, Objective, Options as DecOptions, PAPER_KS, decompose};
 use crate::env::{self, CubeMap};
@@ -41,20 +42,36 @@ const SAT_TARGET: f32 = 0.005;
 const SUB: usize = 8;
 /// The merge objectives compared, the default first.
 const OBJECTIVES: [Objective; 2] = [Objective::Bound, Objective::Paper];
+/// Least total time of each CPU throughput measurement at the default `--n`, in ms
+/// ([`Options::scaled`]).
+const CPU_MIN_MS: usize = 400;
+/// Least total time of the wgpu throughput measurement at the default `--n`, in ms.
+const GPU_MIN_MS: usize = 600;
+/// Copies of the point set in the wgpu dispatch at the default `--n`.
+const GPU_COPIES: usize = 64;
 
-struct Row {
-    objective: Objective,
-    k: usize,
+/// The errors of one decomposition.
+#[derive(Clone, Debug)]
+pub struct Row {
+    /// Merge objective.
+    pub objective: Objective,
+    /// Regions.
+    pub k: usize,
     /// Relative L2 per variant.
-    errors: Vec<f64>,
+    pub errors: Vec<f64>,
     /// Eq. 13 summed over the regions, as a relative L2.
-    bound: f64,
+    pub bound: f64,
 }
 
-struct EnvResult {
-    name: String,
-    rows: Vec<Row>,
-    points: usize,
+/// The accuracy study of one environment.
+#[derive(Clone, Debug)]
+pub struct EnvResult {
+    /// Name.
+    pub name: String,
+    /// One row per objective and `K`.
+    pub rows: Vec<Row>,
+    /// Shading points.
+    pub points: usize,
 }
 
 fn study(name: &str, cube: &CubeMap) -> Result<EnvResult, Box<dyn Error>> {
@@ -101,28 +118,36 @@ fn study(name: &str, cube: &CubeMap) -> Result<EnvResult, Box<dyn Error>> {
     })
 }
 
-/// Median time of `f` over repeats filling at least `min` in total (at least 3 runs).
-fn time(min: Duration, mut f: impl FnMut()) -> f64 {
-    let mut ts = Vec::new();
-    let start = Instant::now();
-    while ts.len() < 3 || (start.elapsed() < min && ts.len() < 50) {
-        let t = Instant::now();
-        f();
-        ts.push(t.elapsed().as_secs_f64());
-    }
-    ts.sort_by(f64::total_cmp);
-    ts[ts.len() / 2]
+/// RSL evaluations/s of each backend (wgpu's, or why not), and the workload.
+#[derive(Clone, Debug)]
+pub struct Throughput {
+    /// Scalar kernel.
+    pub scalar: f64,
+    /// SIMD kernel.
+    pub simd: f64,
+    /// wgpu kernel, or why not.
+    pub gpu: Result<f64, String>,
+    /// Moments kernel, scalar.
+    pub moments: f64,
+    /// Moments kernel, SIMD.
+    pub moments_simd: f64,
+    /// Shading points.
+    pub points: usize,
+    /// Lights.
+    pub lights: usize,
+    /// Copies of the points in the wgpu dispatch.
+    pub gpu_copies: usize,
 }
 
-/// RSL evaluations/s of each backend (wgpu's, or why not), and the workload.
-struct Throughput {
-    scalar: f64,
-    simd: f64,
-    gpu: Result<f64, String>,
-    moments: f64,
-    moments_simd: f64,
-    points: usize,
-    lights: usize,
+/// Everything the section measures.
+#[derive(Clone, Debug)]
+pub struct ShadeResults {
+    /// The default sky's accuracy study.
+    pub sky: EnvResult,
+    /// The real environment's.
+    pub real: EnvResult,
+    /// Throughput.
+    pub throughput: Throughput,
 }
 
 /// Throughput in RSL evaluations per second: scalar, SIMD, wgpu (or why not).
@@ -135,8 +160,10 @@ fn throughput(opts: &Options) -> Result<Throughput, Box<dyn Error>> {
     let sat = sh::fit_sat(&brdf, &refs, SAT_TARGET);
     let scene = Scene::standard(12);
     let vdts = sh::par_map(&scene.points, |p| sh::point_vdt(&scene, p, 64));
-    let evals = (scene.points.len() * lights.len()) as f64;
-    let t_scalar = time(Duration::from_millis(400), || {
+    let evals = scene.points.len() * lights.len();
+    let cpu_min = Duration::from_millis(opts.scaled(CPU_MIN_MS) as u64);
+    let time = |f: &mut dyn FnMut()| median_time_for(opts.repeats, cpu_min, f);
+    let t_scalar = time(&mut || {
         for (p, v) in scene.points.iter().zip(&vdts) {
             if let Ok(vis) = VdtVisibility::new(v.view(), VdtQuery::Gradient) {
                 black_box(shade::shade(&p.frame, p.wo, &sat, &vis, black_box(&lights)));
@@ -144,7 +171,7 @@ fn throughput(opts: &Options) -> Result<Throughput, Box<dyn Error>> {
         }
     });
     let moments: Vec<_> = sh::par_map(&scene.points, |p| sh::point_moments(&scene, p, 64));
-    let t_moments = time(Duration::from_millis(400), || {
+    let t_moments = time(&mut || {
         for (p, m) in scene.points.iter().zip(&moments) {
             black_box(shade::shade_moments(
                 &p.frame,
@@ -155,7 +182,7 @@ fn throughput(opts: &Options) -> Result<Throughput, Box<dyn Error>> {
             ));
         }
     });
-    let t_moments_simd = time(Duration::from_millis(400), || {
+    let t_moments_simd = time(&mut || {
         black_box(sh::shade_points_moments_simd(
             &scene,
             &sat,
@@ -163,7 +190,7 @@ fn throughput(opts: &Options) -> Result<Throughput, Box<dyn Error>> {
             black_box(&lights),
         ));
     });
-    let t_simd = time(Duration::from_millis(400), || {
+    let t_simd = time(&mut || {
         black_box(sh::shade_points_simd(
             &scene,
             &sat,
@@ -172,17 +199,18 @@ fn throughput(opts: &Options) -> Result<Throughput, Box<dyn Error>> {
             VdtQuery::Gradient,
         ));
     });
+    let gpu_copies = opts.scaled(GPU_COPIES);
     let gpu = if !opts.gpu {
         Err("not requested".to_string())
     } else {
         match try_gpu() {
             Err(e) => Err(format!("no adapter: {e}")),
             Ok(mut g) => {
-                // 64 copies of the point set (each row names its point's VDT), one dispatch.
+                // Copies of the point set (each row names its point's VDT), one dispatch.
                 let table = sh::gpu_table(&sat, &vdts, &lights, VdtQuery::Gradient)
                     .ok_or("anisotropic SAT")?;
                 let base = sh::gpu_input(&scene);
-                let reps = 64;
+                let reps = gpu_copies;
                 let n = base.n * reps;
                 let mut input = Columns::zeros(base.arity, n);
                 for c in 0..base.arity {
@@ -200,28 +228,30 @@ fn throughput(opts: &Options) -> Result<Throughput, Box<dyn Error>> {
                 match g.run_custom(&custom, &input, &mut out) {
                     Err(e) => Err(format!("kernel failed: {e}")),
                     Ok(()) => {
-                        let t = time(Duration::from_millis(600), || {
+                        let min = Duration::from_millis(opts.scaled(GPU_MIN_MS) as u64);
+                        let t = median_time_for(opts.repeats, min, || {
                             let _ = g.run_custom(&custom, &input, &mut out);
                         });
-                        Ok((n * lights.len()) as f64 / t)
+                        Ok(per_second(n * lights.len(), t))
                     }
                 }
             }
         }
     };
     Ok(Throughput {
-        scalar: evals / t_scalar,
-        simd: evals / t_simd,
+        scalar: per_second(evals, t_scalar),
+        simd: per_second(evals, t_simd),
         gpu,
-        moments: evals / t_moments,
-        moments_simd: evals / t_moments_simd,
+        moments: per_second(evals, t_moments),
+        moments_simd: per_second(evals, t_moments_simd),
         points: scene.points.len(),
         lights: lights.len(),
+        gpu_copies,
     })
 }
 
-/// The report section.
-pub fn section(opts: &Options) -> Result<Section, Box<dyn Error>> {
+/// Runs the section's measurements.
+pub fn measure(opts: &Options) -> Result<ShadeResults, Box<dyn Error>> {
     let bar = ProgressBar::new(3).with_style(
         ProgressStyle::with_template("shade    {bar:30} {pos}/{len} {msg}")
             .unwrap_or_else(|_| ProgressStyle::default_bar()),
@@ -236,17 +266,29 @@ pub fn section(opts: &Options) -> Result<Section, Box<dyn Error>> {
     )?;
     bar.inc(1);
     bar.set_message("throughput");
+    let throughput = throughput(opts)?;
+    bar.inc(1);
+    bar.finish_and_clear();
+    Ok(ShadeResults {
+        sky,
+        real,
+        throughput,
+    })
+}
+
+/// The section of measured results.
+pub fn render(r: &ShadeResults) -> Section {
+    let (sky, real) = (&r.sky, &r.real);
     let Throughput {
         scalar,
         simd,
-        gpu,
+        ref gpu,
         moments,
         moments_simd,
         points: np,
         lights: nk,
-    } = throughput(opts)?;
-    bar.inc(1);
-    bar.finish_and_clear();
+        gpu_copies,
+    } = r.throughput;
 
     let vi = |v: Variant| VARIANTS.iter().position(|&x| x == v).unwrap_or(0);
     let mut html = String::new();
@@ -266,7 +308,7 @@ pub fn section(opts: &Options) -> Result<Section, Box<dyn Error>> {
          objective.</p>",
         sky.points
     );
-    for e in [&sky, &real] {
+    for e in [sky, real] {
         let _ = writeln!(
             html,
             "<h3>{}</h3><table><tr><th>merge</th><th>K</th><th>kernel</th><th>kernel, eq. 9 VDT</th>\
@@ -312,14 +354,14 @@ pub fn section(opts: &Options) -> Result<Section, Box<dyn Error>> {
         }
         let _ = writeln!(html, "</table>");
     }
-    let gpu_s = match &gpu {
+    let gpu_s = match gpu {
         Ok(x) => format!("{:.1} M/s", x / 1e6),
         Err(e) => format!("n/a ({e})"),
     };
     let _ = writeln!(
         html,
         "<h3>Throughput</h3><p>{np} points × K = {nk} RSLs, Lambert, 64² VDTs, gradient query \
-         (wgpu: 64 copies of the points in one dispatch, full round trip including the table \
+         (wgpu: {gpu_copies} copies of the points in one dispatch, full round trip including the table \
          upload).</p><table><tr><th>backend</th><th>RSL evaluations/s</th><th>vs scalar</th>\
          <th>vs paper (19.4 M/s, 2005 GPU)</th></tr>\
          <tr><td>scalar</td><td>{:.1} M/s</td><td>1</td><td>{:.2}</td></tr>\
@@ -368,13 +410,13 @@ pub fn section(opts: &Options) -> Result<Section, Box<dyn Error>> {
             })).collect::<Vec<_>>(),
         })
     };
-    Ok(Section {
+    Section {
         id: "shade",
         title: "RSL shading: accuracy per K and throughput".into(),
         summary,
         html,
         data: json!({
-            "environments": [env_json(&sky), env_json(&real)],
+            "environments": [env_json(sky), env_json(real)],
             "paper": PAPER.iter().map(|p| json!({"k": p.0, "fig9": p.1, "fig10": p.2})).collect::<Vec<_>>(),
             "throughput": {
                 "scalar": scalar, "simd": simd, "moments_scalar": moments,
@@ -385,5 +427,10 @@ pub fn section(opts: &Options) -> Result<Section, Box<dyn Error>> {
             },
         }),
         files: Vec::new(),
-    })
+    }
+}
+
+/// The report section.
+pub fn section(opts: &Options) -> Result<Section, Box<dyn Error>> {
+    Ok(render(&measure(opts)?))
 }

@@ -17,27 +17,64 @@ use steradian_core::rsl::vdt::{Vdt, scratch_len, signed_distance_into};
 use steradian_core::{Vec2, wgsl};
 
 use super::Options;
-use super::sat::{REPEATS, time};
+use super::plot::{Axis, Chart, Pt, Scale, Series};
 use super::section::Section;
-use crate::backend::gpu::{Custom, try_gpu};
+use super::timing::{median_time, ns_per};
+use crate::backend::gpu::{Custom, Gpu, try_gpu};
 use crate::kernels::Columns;
 use crate::rng::Rng;
-use crate::vdt::{Dist, Family, edge_error_by_angle, errors, spheres_mask, study};
+use crate::vdt::{Dist, Family, FamilyErrors, edge_error_by_angle, errors, spheres_mask, study};
 
 const SEED: u64 = 0x0bd7_5eed;
+/// Queries per timed run at the default `--n` ([`Options::scaled`]).
 const QUERIES: usize = 1 << 18;
+/// Side of the EDT build timing.
+const BUILD_SIDE: usize = 512;
+/// Sides of the query timings.
+const QUERY_SIDES: [usize; 2] = [64, 512];
 
-struct Speed {
-    n: usize,
-    scalar: Duration,
-    simd: Duration,
-    sat: Duration,
-    gpu: Option<Duration>,
+/// Median query times on one table size.
+#[derive(Clone, Debug)]
+pub struct Speed {
+    /// Table side.
+    pub n: usize,
+    /// Scalar VDT query (both estimates).
+    pub scalar: Duration,
+    /// SIMD VDT query.
+    pub simd: Duration,
+    /// Scalar SAT square of the same map.
+    pub sat: Duration,
+    /// wgpu VDT query, upload and read-back included.
+    pub gpu: Option<Duration>,
 }
 
+/// Everything the section measures.
+#[derive(Clone, Debug)]
+pub struct VdtResults {
+    /// Exact signed EDT, ns per texel at [`BUILD_SIDE`]².
+    pub edt_ns: f64,
+    /// SAT build of the same map, ns per texel.
+    pub sat_build_ns: f64,
+    /// Queries per timed run.
+    pub queries: usize,
+    /// Timed repeats.
+    pub repeats: usize,
+    /// The GPU adapter, or why there is none.
+    pub gpu_note: String,
+    /// Query times per table side.
+    pub speeds: Vec<Speed>,
+    /// Error distributions per family.
+    pub families: Vec<(Family, FamilyErrors)>,
+    /// Straight edges: (angle in degrees, mean |error| of [eq. 9, gradient, SAT]).
+    pub angles: Vec<(f64, [f64; 3])>,
+}
+
+/// Median query times on an `n × n` table of the spheres mask, `queries` random squares.
 fn query_speed(
     n: usize,
-    gpu: &mut Option<crate::backend::gpu::Gpu>,
+    queries: usize,
+    repeats: usize,
+    gpu: &mut Option<Gpu>,
 ) -> Result<Speed, Box<dyn Error>> {
     let m = spheres_mask(n);
     let vdt = Vdt::build(n, n, &m)?;
@@ -45,39 +82,39 @@ fn query_speed(
     let texels: Vec<f32> = m.iter().map(|&b| b as u8 as f32).collect();
     let sat = Sat::build(n, n, &texels)?;
     let mut rng = Rng::new(SEED ^ n as u64);
-    let u: Vec<f32> = (0..QUERIES)
+    let u: Vec<f32> = (0..queries)
         .map(|_| rng.range(0.0, n as f64) as f32)
         .collect();
-    let v: Vec<f32> = (0..QUERIES)
+    let v: Vec<f32> = (0..queries)
         .map(|_| rng.range(0.0, n as f64) as f32)
         .collect();
-    let r: Vec<f32> = (0..QUERIES)
+    let r: Vec<f32> = (0..queries)
         .map(|_| rng.log_range(0.5, n as f64 / 8.0) as f32)
         .collect();
-    let (mut a, mut b) = (vec![0.0f32; QUERIES], vec![0.0f32; QUERIES]);
-    let scalar = time(|| {
-        for k in 0..QUERIES {
+    let (mut a, mut b) = (vec![0.0f32; queries], vec![0.0f32; queries]);
+    let scalar = median_time(repeats, || {
+        for k in 0..queries {
             let (x, y) = view.query(u[k], v[k], r[k]);
             a[k] = x;
             b[k] = y;
         }
         black_box(&a);
     });
-    let simd = time(|| {
+    let simd = median_time(repeats, || {
         steradian_simd::rsl::vdt::query_slices(&view, &u, &v, &r, &mut a, &mut b);
         black_box(&a);
     });
-    let sat_t = time(|| {
-        for k in 0..QUERIES {
+    let sat_t = median_time(repeats, || {
+        for k in 0..queries {
             a[k] = sat.square(Vec2::new(u[k], v[k]), r[k]);
         }
         black_box(&a);
     });
     let gpu_t = match gpu {
         Some(g) => {
-            let rows: Vec<[f32; 3]> = (0..QUERIES).map(|k| [u[k], v[k], r[k]]).collect();
+            let rows: Vec<[f32; 3]> = (0..queries).map(|k| [u[k], v[k], r[k]]).collect();
             let input = Columns::from_rows(&rows);
-            let mut out = Columns::zeros(2, QUERIES);
+            let mut out = Columns::zeros(2, queries);
             let table = vdt.gpu_table();
             let custom = Custom {
                 label: "vdt-query",
@@ -85,7 +122,7 @@ fn query_speed(
                 table: Some(&table),
             };
             g.run_custom(&custom, &input, &mut out)?;
-            Some(time(|| {
+            Some(median_time(repeats, || {
                 g.run_custom(&custom, &input, &mut out).expect("GPU run");
             }))
         }
@@ -100,104 +137,25 @@ fn query_speed(
     })
 }
 
-fn svg_angles(pts: &[(f64, [f64; 3])]) -> String {
-    let (w, h, l, b, t, r) = (560.0, 320.0, 60.0, 40.0, 30.0, 20.0);
-    let ymax = pts
-        .iter()
-        .flat_map(|p| p.1)
-        .fold(0.0f64, f64::max)
-        .max(1e-3)
-        * 1.1;
-    let x = |a: f64| l + a / 90.0 * (w - l - r);
-    let y = |e: f64| h - b - e / ymax * (h - b - t);
-    let mut s = format!(
-        r#"<svg xmlns="http://www.w3.org/2000/svg" width="{w}" height="{h}" viewBox="0 0 {w} {h}" font-family="sans-serif" font-size="11"><rect width="100%" height="100%" fill="white"/>
-<line x1="{l}" y1="{}" x2="{}" y2="{}" stroke="black"/><line x1="{l}" y1="{t}" x2="{l}" y2="{}" stroke="black"/>
-<text x="{}" y="{}" text-anchor="middle">edge normal angle (degrees, folded into [0, 90))</text>
-<text x="14" y="{}" transform="rotate(-90 14 {})" text-anchor="middle">mean |error| of the visible fraction</text>
-"#,
-        h - b,
-        w - r,
-        h - b,
-        h - b,
-        (l + w - r) / 2.0,
-        h - 8.0,
-        h / 2.0,
-        h / 2.0
-    );
-    for k in 0..=6 {
-        let a = k as f64 * 15.0;
-        let _ = write!(
-            s,
-            r#"<text x="{}" y="{}" text-anchor="middle">{a}</text>"#,
-            x(a),
-            h - b + 14.0
-        );
-    }
-    for k in 0..=4 {
-        let e = ymax * k as f64 / 4.0;
-        let _ = write!(
-            s,
-            r#"<text x="{}" y="{}" text-anchor="end">{e:.3}</text><line x1="{l}" x2="{}" y1="{}" y2="{}" stroke="lightgray"/>"#,
-            l - 4.0,
-            y(e) + 4.0,
-            w - r,
-            y(e),
-            y(e)
-        );
-    }
-    for (c, (name, color)) in [
-        ("eq. 9", "#d62728"),
-        ("gradient variant", "#2ca02c"),
-        ("SAT of binary map", "#1f77b4"),
-    ]
-    .iter()
-    .enumerate()
-    {
-        let path: Vec<String> = pts
-            .iter()
-            .map(|p| format!("{:.1},{:.1}", x(p.0), y(p.1[c])))
-            .collect();
-        let _ = write!(
-            s,
-            r#"<polyline fill="none" stroke="{color}" stroke-width="2" points="{}"/><text x="{}" y="{}" fill="{color}">{name}</text>"#,
-            path.join(" "),
-            l + 10.0 + 150.0 * c as f64,
-            t - 10.0
-        );
-    }
-    s.push_str("</svg>");
-    s
-}
-
-fn row(name: &str, d: &Dist) -> String {
-    format!(
-        "<td>{name}</td><td>{:.4}</td><td>{:.4}</td><td>{:.4}</td>",
-        d.mean, d.p99, d.max
-    )
-}
-
-/// The section.
-pub fn section(opts: &Options) -> Result<Section, Box<dyn Error>> {
+/// Runs the section's measurements.
+pub fn measure(opts: &Options) -> Result<VdtResults, Box<dyn Error>> {
     let bar = ProgressBar::new(7).with_style(
         ProgressStyle::with_template("vdt      {bar:30} {pos}/{len} {msg}")
             .unwrap_or_else(|_| ProgressStyle::default_bar()),
     );
     // EDT build time at 512².
     bar.set_message("exact EDT 512²");
-    let n = 512;
+    let n = BUILD_SIDE;
     let m = spheres_mask(n);
     let mut out = vec![0.0f32; n * n];
     let mut scratch = vec![0.0f64; scratch_len(n, n)];
-    let t_edt = time(|| {
+    let t_edt = median_time(opts.repeats, || {
         signed_distance_into(n, n, &m, &mut out, &mut scratch).expect("valid map");
     });
     let texels: Vec<f32> = m.iter().map(|&b| b as u8 as f32).collect();
-    let t_sat_build = time(|| {
+    let t_sat_build = median_time(opts.repeats, || {
         black_box(Sat::build(n, n, &texels).expect("valid map"));
     });
-    let edt_ns = t_edt.as_secs_f64() * 1e9 / (n * n) as f64;
-    let sat_build_ns = t_sat_build.as_secs_f64() * 1e9 / (n * n) as f64;
     bar.inc(1);
 
     bar.set_message("query speed");
@@ -212,24 +170,79 @@ pub fn section(opts: &Options) -> Result<Section, Box<dyn Error>> {
             Err(e) => gpu_note = format!("no adapter: {e}"),
         }
     }
-    let speeds = [query_speed(64, &mut gpu)?, query_speed(512, &mut gpu)?];
+    let queries = opts.scaled(QUERIES);
+    let speeds = QUERY_SIDES
+        .iter()
+        .map(|&side| query_speed(side, queries, opts.repeats, &mut gpu))
+        .collect::<Result<Vec<_>, _>>()?;
     bar.inc(2);
 
     bar.set_message("error study");
-    let mut fam = Vec::new();
+    let mut families = Vec::new();
     for f in Family::ALL {
-        fam.push((f, errors(&study(f, SEED, 12, 80))));
+        families.push((f, errors(&study(f, SEED, 12, 80))));
         bar.inc(1);
     }
     let angles = edge_error_by_angle(SEED, 180, 12, 18);
     bar.inc(1);
     bar.finish_and_clear();
+    Ok(VdtResults {
+        edt_ns: ns_per(n * n, t_edt),
+        sat_build_ns: ns_per(n * n, t_sat_build),
+        queries,
+        repeats: opts.repeats,
+        gpu_note,
+        speeds,
+        families,
+        angles,
+    })
+}
 
-    let ns = |d: Duration| d.as_secs_f64() * 1e9 / QUERIES as f64;
+/// Mean |error| against the edge orientation, a line per estimate.
+fn plot(angles: &[(f64, [f64; 3])]) -> String {
+    let ymax = angles
+        .iter()
+        .flat_map(|p| p.1)
+        .fold(0.0f64, f64::max)
+        .max(1e-3)
+        * 1.1;
+    let series = ["eq. 9", "gradient variant", "SAT of binary map"]
+        .iter()
+        .enumerate()
+        .map(|(c, name)| Series::line(*name, angles.iter().map(|p| Pt::new(p.0, p.1[c])).collect()))
+        .collect();
+    let ticks = (0..=6)
+        .map(|k| (k as f64 * 15.0, format!("{}", k * 15)))
+        .collect();
+    Chart::new(
+        "Straight edges: mean |error| against the edge orientation",
+        Axis::new(
+            "edge normal angle (degrees, folded into [0, 90))",
+            Scale::Linear,
+        )
+        .range(0.0, 90.0)
+        .ticks(ticks),
+        Axis::new("mean |error| of the visible fraction", Scale::Linear).range(0.0, ymax),
+        series,
+    )
+    .svg()
+}
+
+fn row(name: &str, d: &Dist) -> String {
+    format!(
+        "<td>{name}</td><td>{:.4}</td><td>{:.4}</td><td>{:.4}</td>",
+        d.mean, d.p99, d.max
+    )
+}
+
+/// The summary text of the section.
+fn summary(r: &VdtResults) -> String {
+    let ns = |d: Duration| ns_per(r.queries, d);
     let mut summary = format!(
-        "exact signed EDT {edt_ns:.1} ns/texel at 512² (SAT build of the same map {sat_build_ns:.1} ns/texel)\n"
+        "exact signed EDT {:.1} ns/texel at 512² (SAT build of the same map {:.1} ns/texel)\n",
+        r.edt_ns, r.sat_build_ns
     );
-    for s in &speeds {
+    for s in &r.speeds {
         let _ = writeln!(
             summary,
             "VDT query at {}²: scalar {:.2} ns, SIMD {:.2} ns ({:.2}× scalar), SAT square {:.2} ns{}",
@@ -243,7 +256,7 @@ pub fn section(opts: &Options) -> Result<Section, Box<dyn Error>> {
                 .unwrap_or_default()
         );
     }
-    for (f, e) in &fam {
+    for (f, e) in &r.families {
         let _ = writeln!(
             summary,
             "{:15} mean |err| vs exact: eq.9 {:.4}, gradient {:.4}, SAT of binary map {:.4} (max {:.3} / {:.3} / {:.3})",
@@ -256,7 +269,12 @@ pub fn section(opts: &Options) -> Result<Section, Box<dyn Error>> {
             e.sat.max
         );
     }
+    summary
+}
 
+/// The HTML of the section, with the figure `svg` inline.
+fn html(r: &VdtResults, svg: &str) -> String {
+    let ns = |d: Duration| ns_per(r.queries, d);
     let mut html = String::new();
     let _ = write!(
         html,
@@ -267,17 +285,22 @@ pub fn section(opts: &Options) -> Result<Section, Box<dyn Error>> {
          square on the visible side of that line. Both read one bilinear cell (4 samples); the \
          SAT of the binary map (4 lookups, exact for the map) is the reference point.</p>\
          <h3>Build</h3><table><tr><th>what</th><th>ns per texel at 512²</th></tr>\
-         <tr><td>exact signed EDT (ours)</td><td>{edt_ns:.1}</td></tr>\
-         <tr><td>SAT build of the same map (same run)</td><td>{sat_build_ns:.1}</td></tr></table>\
+         <tr><td>exact signed EDT (ours)</td><td>{:.1}</td></tr>\
+         <tr><td>SAT build of the same map (same run)</td><td>{:.1}</td></tr></table>\
          <p>imageproc's <code>euclidean_squared_distance_transform</code> (unsigned, to pixel \
          centres of one class) on the same map is in <code>cargo bench -p steradian-benches \
          --bench vdt</code> (not a harness dependency).</p>\
-         <h3>Queries ({QUERIES} random squares, median of {REPEATS}, SIMD {})</h3>\
+         <h3>Queries ({} random squares, median of {}, SIMD {})</h3>\
          <table><tr><th>table</th><th>scalar (both estimates)</th><th>SIMD</th><th>SIMD/scalar</th>\
-         <th>SAT square, scalar</th><th>wgpu ({gpu_note})</th></tr>",
-        steradian_simd::isa()
+         <th>SAT square, scalar</th><th>wgpu ({})</th></tr>",
+        r.edt_ns,
+        r.sat_build_ns,
+        r.queries,
+        r.repeats,
+        steradian_simd::isa(),
+        r.gpu_note
     );
-    for s in &speeds {
+    for s in &r.speeds {
         let _ = write!(
             html,
             "<tr><td>{}²</td><td>{:.2} ns</td><td>{:.2} ns</td><td>{:.2}×</td><td>{:.2} ns</td><td>{}</td></tr>",
@@ -296,7 +319,7 @@ pub fn section(opts: &Options) -> Result<Section, Box<dyn Error>> {
          half-diagonal 1–8 texels)</h3><table><tr><th>family</th><th>queries</th>\
          <th>estimate</th><th>mean |err|</th><th>p99</th><th>max</th></tr>",
     );
-    for (f, e) in &fam {
+    for (f, e) in &r.families {
         for (k, (name, d)) in [
             ("eq. 9 vs exact", &e.eq9),
             ("gradient vs exact", &e.gradient),
@@ -321,30 +344,45 @@ pub fn section(opts: &Options) -> Result<Section, Box<dyn Error>> {
          f64). The SAT of the binary map carries only the rasterisation error.</p>\
          <h3>Straight edges: mean |error| against the edge orientation</h3>",
     );
-    let svg = svg_angles(&angles);
-    html.push_str(&svg);
+    html.push_str(svg);
+    html
+}
 
-    let fam_json: Vec<_> = fam
+/// The data of the section in `report.json`.
+fn data(r: &VdtResults) -> serde_json::Value {
+    let ns = |d: Duration| ns_per(r.queries, d);
+    let fam_json: Vec<_> = r
+        .families
         .iter()
         .map(|(f, e)| json!({"family": f.name(), "errors": e}))
         .collect();
-    let data = json!({
-        "edt_ns_per_texel_512": edt_ns,
-        "sat_build_ns_per_texel_512": sat_build_ns,
-        "query_ns": speeds.iter().map(|s| json!({
+    json!({
+        "edt_ns_per_texel_512": r.edt_ns,
+        "sat_build_ns_per_texel_512": r.sat_build_ns,
+        "query_ns": r.speeds.iter().map(|s| json!({
             "side": s.n, "scalar": ns(s.scalar), "simd": ns(s.simd), "sat_square": ns(s.sat),
             "wgpu": s.gpu.map(ns),
         })).collect::<Vec<_>>(),
-        "gpu": gpu_note,
+        "gpu": r.gpu_note,
         "errors": fam_json,
-        "edge_error_by_angle": angles.iter().map(|(a, e)| json!({"angle": a, "eq9": e[0], "gradient": e[1], "sat": e[2]})).collect::<Vec<_>>(),
-    });
-    Ok(Section {
+        "edge_error_by_angle": r.angles.iter().map(|(a, e)| json!({"angle": a, "eq9": e[0], "gradient": e[1], "sat": e[2]})).collect::<Vec<_>>(),
+    })
+}
+
+/// The section of measured results.
+pub fn render(r: &VdtResults) -> Section {
+    let svg = plot(&r.angles);
+    Section {
         id: "vdt",
         title: "Visibility distance tables".into(),
-        summary,
-        html,
-        data,
+        summary: summary(r),
+        html: html(r, &svg),
+        data: data(r),
         files: vec![("vdt_error_by_angle.svg".into(), svg.into_bytes())],
-    })
+    }
+}
+
+/// The section.
+pub fn section(opts: &Options) -> Result<Section, Box<dyn Error>> {
+    Ok(render(&measure(opts)?))
 }
