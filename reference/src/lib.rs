@@ -1,7 +1,8 @@
 //! Exact `f64` references for every steradian kernel: closed forms where they exist,
 //! brute forces and adaptive quadrature where they do not. One reference per kernel, used
 //! by the harness (accuracy tables, table generators, the report), by the tests of
-//! `steradian-core`, `steradian-simd` and the harness, and by the fuzz targets.
+//! `steradian-core` and the harness, and by the fuzz targets (the SIMD kernels are checked
+//! lane by lane against the scalar ones, not against a reference).
 //!
 //! The folders mirror core's: [`lobe`] for the cosine-lobe paper, [`rsl`] for the
 //! rotatable-square-lights paper; [`quad`] is the shared quadrature rule. Nothing here
