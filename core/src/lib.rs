@@ -17,9 +17,11 @@
 //! - **Equal-area hemisphere map.** `p = (x, y)/sqrt(1 + z)`, inverse `z = 1 − |p|²`,
 //!   `(x, y) = p·sqrt(2 − |p|²)`; `dω = 2·du·dv`. The disk is inscribed in the texture
 //!   square: `uv = (p + 1)/2`.
-//! - **Spherical harmonics** (later kernels): real SH of the HVL paper eq. 7–8 with the
+//! - **Spherical harmonics** ([`sh`]): real SH of the HVL paper eq. 7–8 with the
 //!   Condon–Shortley phase, order `l = 0..n-1`, `m = −l..l`, flat index `l² + l + m`.
-//! - **Precision.** `f32` in kernels; `f64` only in references and table generators.
+//! - **Precision.** `f32` in kernels; `f64` only in references and table generators, and
+//!   inside a kernel only where `f32` arithmetic cannot meet its stated bound (the SH
+//!   recurrence, [`sh`]; inputs and outputs stay `f32`).
 //!
 //! ## Bad input
 //!
@@ -99,6 +101,7 @@ pub mod frame;
 pub mod grid;
 pub mod lobe;
 pub mod rsl;
+pub mod sh;
 pub mod table;
 pub mod wgsl;
 

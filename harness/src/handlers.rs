@@ -4,9 +4,9 @@
 //! (`crate::registry`) names each kernel's handler.
 
 use serde_json::{Map, Value, json};
-use steradian_core::{Vec2, lobe, lobe::cap, rsl::hemisphere};
+use steradian_core::{Vec2, lobe, lobe::cap, rsl::hemisphere, sh};
 
-use crate::json::{exponent, nonzero, num, number, scale, vector};
+use crate::json::{bands, exponent, nonzero, num, number, scale, vector};
 
 /// `lobe-integral`: `{"exponent": e, "scale": s}` → `{"integral": 2πs/(e+1)}`.
 pub fn lobe_integral(obj: &Map<String, Value>) -> Result<Value, String> {
@@ -59,4 +59,13 @@ pub fn hemisphere_unmap(obj: &Map<String, Value>) -> Result<Value, String> {
     }
     let d = hemisphere::unmap(Vec2::new(u, v));
     Ok(json!({ "dir": [num(d.x), num(d.y), num(d.z)] }))
+}
+
+/// `sh-eval`: `{"dir": [x, y, z], "bands": n}` → `{"y": [n² values]}` (index `l² + l + m`).
+pub fn sh_eval(obj: &Map<String, Value>) -> Result<Value, String> {
+    let d = nonzero(vector::<3>(obj, "dir")?, "dir")?;
+    let n = bands(obj, sh::MAX_BANDS)?;
+    let mut y = vec![0.0f32; n * n];
+    sh::eval_into(d, n, &mut y).map_err(|e| e.to_string())?;
+    Ok(json!({ "y": y.into_iter().map(num).collect::<Vec<_>>() }))
 }

@@ -85,6 +85,23 @@ pub fn exponent(obj: &Map<String, Value>) -> Result<f32, String> {
     Ok(e)
 }
 
+/// Field `"bands"` as an integer in `1..=max` (a JSON integer, or a number with no
+/// fractional part).
+pub fn bands(obj: &Map<String, Value>, max: usize) -> Result<usize, String> {
+    let v = field(obj, "bands")?;
+    let n = match v.as_u64() {
+        Some(n) => n,
+        None => match v.as_f64() {
+            Some(x) if x.fract() == 0.0 && x >= 0.0 && x <= u64::MAX as f64 => x as u64,
+            _ => return Err(format!("bands must be a positive integer, got {v}")),
+        },
+    };
+    if n == 0 || n > max as u64 {
+        return Err(format!("bands = {n} is outside 1..={max}"));
+    }
+    Ok(n as usize)
+}
+
 /// Field `"scale"` as a finite `f32`, 1 when absent.
 pub fn scale(obj: &Map<String, Value>) -> Result<f32, String> {
     match obj.get("scale") {

@@ -42,10 +42,12 @@ impl<T: Copy> Piece<T> {
 /// The paper a kernel implements (its folder in `core/src` and `simd/src`).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Paper {
-    /// `lobe/`: cosine lobes, cap → lobe fits, lobe products and sums (Lindemann et al.).
+    /// `lobe/`: cosine lobes, cap → lobe fits, lobe products and sums (Meunier et al.).
     Lobe,
-    /// `rsl/`: rotatable square lights, SAT, VDT, shading (the RSL paper).
+    /// `rsl/`: rotatable square lights, SAT, VDT, shading (Xu et al.).
     Rsl,
+    /// `sh/`: real spherical harmonics and the projections of the HVL paper (Mézières et al.).
+    Sh,
 }
 
 impl Paper {
@@ -54,6 +56,7 @@ impl Paper {
         match self {
             Paper::Lobe => "lobe",
             Paper::Rsl => "rsl",
+            Paper::Sh => "sh",
         }
     }
 }
@@ -334,6 +337,26 @@ pub const KERNELS: &[KernelSpec] = &[
             "BRDF SATs (steradian_core::rsl::brdf_sat)",
             "visibility moments per point (steradian_core::rsl::vis_moments)",
         ],
+    },
+    KernelSpec {
+        name: "sh-eval",
+        paper: Paper::Sh,
+        contract: r#"{"dir": [x,y,z] non-zero, "bands": n in 1..=128} -> {"y": [n² values, index l²+l+m]}"#,
+        eval: Piece::At(handlers::sh_eval),
+        scalar: "steradian_core::sh::eval_into",
+        simd: Piece::At("steradian_simd::sh::eval_slices"),
+        wgsl: Piece::Without(
+            "not written yet: WGSL has no f64, and the f32 recurrence misses the 1e-5 bound \
+             beyond 17 bands (steradian_core::sh module docs)",
+        ),
+        reference: Piece::At("steradian_reference::sh::eval"),
+        bound: Piece::At(Bound {
+            metric: "abs per band",
+            item: "steradian_core::sh::eval_abs_error",
+            value: None,
+        }),
+        batch: None,
+        tables: &[],
     },
 ];
 
