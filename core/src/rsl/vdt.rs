@@ -47,11 +47,17 @@
 //! texel centres, `lerp(a, b, t) = (1 − t)·a + t·b` (exact at the centres), clamped to the
 //! edge outside the band of centres. Two estimates of the visible fraction of the square:
 //!
-//! - [`VdtView::eq9`], the paper's eq. 9: `clamp((√2·r + D)/(2√2·r), 0, 1)`, a ramp of width
-//!   `2√2·r` (four half-sides) in `D`. As printed it is exact only at `D = 0` (½, by
-//!   symmetry, for any orientation) and in the saturated tails: an axis-aligned edge needs a
-//!   ramp of width `2·(r/√2)`, a diagonal one a quadratic; it is off by up to ¼ at `|D|` ≈
-//!   one half-side (measured, harness `vdt` tests and the report).
+//! - [`VdtView::eq9`], the paper's eq. 9: `clamp(((√2/2)·r + D)/(√2·r), 0, 1)`
+//!   `= clamp(½ + D/(√2·r), 0, 1)`. The extracted text is garbled; the geometry it
+//!   describes reads one way only: a square of half-diagonal `r` has half-side `h = r/√2`
+//!   and side `√2·r`, and a straight boundary parallel to a side at signed distance `D`
+//!   from the centre leaves exactly `(h + D)/(2h) = ½ + D/(√2·r)` of it visible, saturating
+//!   at `|D| = h`, where the boundary leaves the square. Eq. 9 is therefore exact for every
+//!   square cut by an axis-aligned straight edge (tested), and for other boundaries it is
+//!   the axis-aligned ramp: a diagonal edge needs a quadratic (off by up to ≈ 0.06 at
+//!   `|D| ≈ h/2`, measured in the harness `vdt` tests and the report). (A ramp of width
+//!   `2√2·r`, the other reading of the garbled text, saturates only at `|D| = √2·r`, beyond
+//!   the square's reach: a square wholly on the occluded side would still be 5 % visible.)
 //! - [`VdtView::gradient`], the straight-edge variant: the gradient of the bilinear `D`
 //!   (the analytic gradient within the cell) gives the edge normal `n`, and the visible
 //!   fraction is the **exact** area of the square on the side `n·(x − p) ≥ −D` of that
@@ -442,7 +448,7 @@ impl<'a> VdtView<'a> {
     }
 
     /// The visible fraction of the square with centre `(u, v)` and half-diagonal `r` by the
-    /// paper's eq. 9: `clamp((√2·r + D)/(2√2·r), 0, 1)`.
+    /// paper's eq. 9: `clamp(½ + D/(√2·r), 0, 1)` (module docs).
     #[inline]
     pub fn eq9(&self, u: f32, v: f32, r: f32) -> f32 {
         eq9_from(self.sample(u, v).d, r)
@@ -481,12 +487,13 @@ fn clamp_r(r: f32) -> f32 {
     r.clamp(R_MIN, R_MAX)
 }
 
-/// Eq. 9 for a sampled `D`: `clamp((√2·r + D)/(2√2·r), 0, 1)`, `r` clamped to
-/// `[R_MIN, R_MAX]`.
+/// Eq. 9 for a sampled `D`: `clamp((½·√2·r + D)/(√2·r), 0, 1) = clamp(½ + D/(√2·r), 0, 1)`
+/// (module docs: the visible fraction of a square of side `√2·r` cut by a straight edge
+/// parallel to a side at distance `D`), `r` clamped to `[R_MIN, R_MAX]`.
 #[inline(always)]
 pub fn eq9_from(d: f32, r: f32) -> f32 {
     let k = SQRT_2 * clamp_r(r);
-    ((k + d) / (2.0 * k)).clamp(0.0, 1.0)
+    ((0.5 * k + d) / k).clamp(0.0, 1.0)
 }
 
 /// The straight-edge fraction for a sampled `D` and gradient: the square of half-side
@@ -602,8 +609,8 @@ mod tests {
         let r = SQRT_2;
         let (e9, g) = v.query(2.5, 1.0, r);
         assert!((g - 0.75).abs() < 1e-6, "{g}");
-        // eq. 9 as printed: (2 + 0.5)/4.
-        assert!((e9 - 0.625).abs() < 1e-6, "{e9}");
+        // Eq. 9, ½ + D/(√2·r) = ½ + 0.5/2: exact for an edge parallel to a side too.
+        assert!((e9 - 0.75).abs() < 1e-6, "{e9}");
     }
 
     #[test]

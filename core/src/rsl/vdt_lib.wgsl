@@ -68,10 +68,11 @@ fn vdt_gradient(c: VdtCell) -> vec2<f32> {
     );
 }
 
-// Eq. 9: the visible fraction of the square of half-diagonal r at distance d.
+// Eq. 9: the visible fraction 1/2 + d/(sqrt(2) r) of the square of half-diagonal r cut by
+// a straight edge at distance d parallel to a side (`rsl::vdt::eq9_from`).
 fn vdt_eq9(d: f32, r: f32) -> f32 {
     let k = SQRT_2 * clamp(r, R_MIN, R_MAX);
-    return clamp((k + d) / (2.0 * k), 0.0, 1.0);
+    return clamp((0.5 * k + d) / k, 0.0, 1.0);
 }
 
 // Straight-edge fraction of the square cut by the line at D with normal along the gradient.

@@ -280,7 +280,7 @@ fn html(r: &VdtResults, svg: &str) -> String {
         html,
         "<p>The VDT stores the exact signed Euclidean distance from each texel centre to the \
          boundary of the binary map (the texel edges between classes), positive where visible. \
-         Eq. 9 is the paper's <code>clamp((√2·r + D)/(2√2·r), 0, 1)</code>; the gradient variant \
+         Eq. 9 is the paper's <code>clamp(½ + D/(√2·r), 0, 1)</code>, exact for a straight edge parallel to a side of the square; the gradient variant \
          takes the edge normal from the bilinear D's gradient and returns the exact area of the \
          square on the visible side of that line. Both read one bilinear cell (4 samples); the \
          SAT of the binary map (4 lookups, exact for the map) is the reference point.</p>\

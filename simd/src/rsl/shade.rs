@@ -264,8 +264,9 @@ fn vdt_lanes(
     let sqrt2 = f32x8::splat(core::f32::consts::SQRT_2);
     match query {
         VdtQuery::Eq9 => {
+            // Eq. 9, `steradian_core::rsl::vdt::eq9_from` operation for operation.
             let k = sqrt2 * rr;
-            let e = (k + dd) / (f32x8::splat(2.0) * k);
+            let e = (f32x8::splat(0.5) * k + dd) / k;
             sel(e.simd_lt(zero), zero, sel(e.simd_gt(one), one, e))
         }
         VdtQuery::Gradient => {

@@ -67,7 +67,7 @@ fn query_lanes<W: Lanes>(view: &VdtView<'_>, [u, v, r]: [W; 3]) -> [W; 2] {
     let rr = clamp(r, W::splat(R_MIN), W::splat(R_MAX));
     // Eq. 9.
     let k = W::splat(SQRT_2) * rr;
-    let e9 = clamp((k + dd) / (W::splat(2.0) * k), zero, one);
+    let e9 = clamp((W::splat(0.5) * k + dd) / k, zero, one);
     // Straight-edge fraction.
     let (ax, ay) = (gx.abs(), gy.abs());
     let m = max_num(ax, ay);
