@@ -1,11 +1,14 @@
 //! `steradian eval KERNEL`: JSON Lines in, JSON Lines out.
 //!
 //! Each input line is user data and is validated like every public constructor: a line
-//! that is not a JSON object, a missing or mistyped field, a vector of the wrong length,
-//! a non-finite number, a zero direction, a negative exponent, an angle outside the kernel's
-//! domain or a disk point outside the unit disk yields `{"error": "..."}` for that line
-//! and the run goes on. Numbers are printed as the shortest decimal that reads back to the
-//! same `f32`.
+//! that is not UTF-8, longer than [`MAX_LINE_BYTES`], not a JSON object, a missing or
+//! mistyped field, a vector of the wrong length, a non-finite number, a zero direction, a
+//! negative exponent, an angle outside the kernel's domain or a disk point outside the unit
+//! disk yields `{"error": "..."}` for that line and the run goes on. Lines end at `\n` (a
+//! `\r` before it is dropped); a last line without `\n` counts; an empty or
+//! whitespace-only line is skipped (no output line). Input is read as bytes, so no byte
+//! sequence stops the run; only an I/O error of the streams does. Numbers are printed as
+//! the shortest decimal that reads back to the same `f32`.
 
 use std::io::{BufRead, Write};
 
@@ -41,16 +44,98 @@ pub fn help() -> String {
     s + "A bad line gets {\"error\": \"...\"} and the run goes on; the exit status is 1 if any line erred."
 }
 
-/// Runs `kernel` over every line of `input`, writing one JSON line per input line (blank
-/// lines are skipped). Returns the number of lines that erred.
-pub fn run(kernel: &str, input: impl BufRead, mut output: impl Write) -> std::io::Result<usize> {
-    let mut errors = 0;
-    for line in input.lines() {
-        let line = line?;
-        if line.trim().is_empty() {
-            continue;
+/// The longest input line `eval` reads (256 MiB); a longer line is a bad line, read past
+/// without being held in memory.
+pub const MAX_LINE_BYTES: usize = 256 << 20;
+
+/// One line of the input as `eval` sees it.
+#[derive(Debug, PartialEq)]
+pub enum Line<'a> {
+    /// The line's text (no `\n`, no trailing `\r`).
+    Text(&'a str),
+    /// The line is not UTF-8; `valid_up_to` bytes are.
+    NotUtf8 {
+        /// Length of the valid prefix.
+        valid_up_to: usize,
+    },
+    /// The line has more than the limit's bytes (its length).
+    TooLong(usize),
+}
+
+/// Reads the next line of `input` into `buf` (cleared first; at most `limit` bytes kept),
+/// `None` at the end of the input.
+pub fn next_line<'b>(
+    input: &mut impl BufRead,
+    buf: &'b mut Vec<u8>,
+    limit: usize,
+) -> std::io::Result<Option<Line<'b>>> {
+    buf.clear();
+    let (mut total, mut any) = (0usize, false);
+    loop {
+        let avail = input.fill_buf()?;
+        if avail.is_empty() {
+            break;
         }
-        let out = eval_line(kernel, &line).unwrap_or_else(|e| {
+        any = true;
+        let (chunk, used, done) = match avail.iter().position(|&b| b == b'\n') {
+            Some(i) => (&avail[..i], i + 1, true),
+            None => (avail, avail.len(), false),
+        };
+        total = total.saturating_add(chunk.len());
+        if total <= limit {
+            buf.extend_from_slice(chunk);
+        } else {
+            buf.clear();
+        }
+        input.consume(used);
+        if done {
+            break;
+        }
+    }
+    if !any {
+        return Ok(None);
+    }
+    if total > limit {
+        return Ok(Some(Line::TooLong(total)));
+    }
+    if buf.last() == Some(&b'\r') {
+        buf.pop();
+    }
+    Ok(Some(match std::str::from_utf8(buf) {
+        Ok(t) => Line::Text(t),
+        Err(e) => Line::NotUtf8 {
+            valid_up_to: e.valid_up_to(),
+        },
+    }))
+}
+
+/// Runs `kernel` over every line of `input` (module docs), writing one JSON line per
+/// non-blank input line. Returns the number of lines that erred.
+pub fn run(kernel: &str, input: impl BufRead, output: impl Write) -> std::io::Result<usize> {
+    run_limited(kernel, input, output, MAX_LINE_BYTES)
+}
+
+/// [`run`] with another line-length limit (the tests use a small one).
+pub fn run_limited(
+    kernel: &str,
+    mut input: impl BufRead,
+    mut output: impl Write,
+    limit: usize,
+) -> std::io::Result<usize> {
+    let mut errors = 0;
+    let mut buf = Vec::new();
+    while let Some(line) = next_line(&mut input, &mut buf, limit)? {
+        let answer = match line {
+            Line::Text(t) if t.trim().is_empty() => continue,
+            Line::Text(t) => eval_line(kernel, t),
+            Line::NotUtf8 { valid_up_to } => Err(format!(
+                "the line is not UTF-8 (invalid byte after {valid_up_to} valid bytes)"
+            )),
+            Line::TooLong(n) => Err(format!(
+                "the line has {n} bytes, more than the limit of {limit}"
+            )),
+        };
+        let out = answer.unwrap_or_else(|e| {
             errors += 1;
             json!({ "error": e })
         });
@@ -130,5 +215,62 @@ mod tests {
         ] {
             assert!(eval_line(k, line).is_err(), "{k} {line}");
         }
+    }
+
+    /// Bytes that are not UTF-8, a line over the limit, CRLF, blank lines and a last line
+    /// without a newline: one answer per non-blank line, the run goes on.
+    #[test]
+    fn any_bytes_one_answer_per_line() {
+        let mut input: Vec<u8> = Vec::new();
+        input.extend_from_slice(b"{\"half_angle\": 0.5}\n");
+        input.extend_from_slice(b"{\"x\": \"\xff\"}\n");
+        input.extend_from_slice(b"\n   \n");
+        input.extend_from_slice(b"{\"half_angle\": 0.25}\r\n");
+        input.extend_from_slice(&[b'7'; 100]);
+        input.extend_from_slice(b"\n\xc3\n{\"half_angle\": 0.125}");
+        let mut out = Vec::new();
+        let errors = run_limited("cap-exponent", input.as_slice(), &mut out, 64).unwrap();
+        let lines: Vec<Value> = String::from_utf8(out)
+            .unwrap()
+            .lines()
+            .map(|l| serde_json::from_str(l).unwrap())
+            .collect();
+        assert_eq!(lines.len(), 6, "{lines:?}");
+        assert_eq!(errors, 3);
+        assert!(lines[0]["exponent"].is_number());
+        assert!(lines[1]["error"].as_str().unwrap().contains("not UTF-8"));
+        assert!(lines[2]["exponent"].is_number());
+        assert!(lines[3]["error"].as_str().unwrap().contains("100 bytes"));
+        assert!(lines[4]["error"].as_str().unwrap().contains("not UTF-8"));
+        assert!(lines[5]["exponent"].is_number());
+    }
+
+    #[test]
+    fn next_line_splits_and_limits() {
+        let mut input: &[u8] = b"ab\r\n\ncd";
+        let mut buf = Vec::new();
+        assert_eq!(
+            next_line(&mut input, &mut buf, 8).unwrap(),
+            Some(Line::Text("ab"))
+        );
+        assert_eq!(
+            next_line(&mut input, &mut buf, 8).unwrap(),
+            Some(Line::Text(""))
+        );
+        assert_eq!(
+            next_line(&mut input, &mut buf, 8).unwrap(),
+            Some(Line::Text("cd"))
+        );
+        assert_eq!(next_line(&mut input, &mut buf, 8).unwrap(), None);
+        let mut long: &[u8] = b"0123456789\nx";
+        assert_eq!(
+            next_line(&mut long, &mut buf, 4).unwrap(),
+            Some(Line::TooLong(10))
+        );
+        assert!(buf.is_empty(), "a long line is not kept");
+        assert_eq!(
+            next_line(&mut long, &mut buf, 4).unwrap(),
+            Some(Line::Text("x"))
+        );
     }
 }
