@@ -69,3 +69,14 @@ pub fn sh_eval(obj: &Map<String, Value>) -> Result<Value, String> {
     sh::eval_into(d, n, &mut y).map_err(|e| e.to_string())?;
     Ok(json!({ "y": y.into_iter().map(num).collect::<Vec<_>>() }))
 }
+
+/// `sh-cap`: `{"dir": [x, y, z], "half_angle": a, "bands": n}` → `{"coeffs": [n² values of
+/// ∫_cap Y_l^m dω]}` (`a` in `[0, π]` radians).
+pub fn sh_cap(obj: &Map<String, Value>) -> Result<Value, String> {
+    let d = nonzero(vector::<3>(obj, "dir")?, "dir")?;
+    let a = number(obj, "half_angle")?;
+    let n = bands(obj, sh::MAX_BANDS)?;
+    let mut c = vec![0.0f32; n * n];
+    sh::cap::coefficients_into(d, a, n, &mut c).map_err(|e| e.to_string())?;
+    Ok(json!({ "coeffs": c.into_iter().map(num).collect::<Vec<_>>() }))
+}

@@ -358,6 +358,25 @@ pub const KERNELS: &[KernelSpec] = &[
         batch: None,
         tables: &[],
     },
+    KernelSpec {
+        name: "sh-cap",
+        paper: Paper::Sh,
+        contract: r#"{"dir": [x,y,z] non-zero, "half_angle": a in [0, π], "bands": n in 1..=128} -> {"coeffs": [n² values of ∫_cap Y_l^m dω]}"#,
+        eval: Piece::At(handlers::sh_cap),
+        scalar: "steradian_core::sh::cap::coefficients_into",
+        simd: Piece::Without(
+            "not written yet: one cap per call is the HVL use; a batch comes with HVL shading",
+        ),
+        wgsl: Piece::Without("not written yet (WGSL has no f64; see sh-eval)"),
+        reference: Piece::At("steradian_reference::sh::cap_zonal"),
+        bound: Piece::At(Bound {
+            metric: "rel (zonal)",
+            item: "steradian_core::sh::cap::ZONAL_REL_ERROR",
+            value: Some(steradian_core::sh::cap::ZONAL_REL_ERROR as f64),
+        }),
+        batch: None,
+        tables: &[],
+    },
 ];
 
 /// The kernel named `name`.

@@ -83,6 +83,8 @@
 //!   *Computer Graphics Forum* 41(6), 2022. DOI: 10.1111/cgf.14564 (arXiv: 2201.01487).
 //!   Equation numbers in this folder are the arXiv version's.
 
+pub mod cap;
+
 use crate::math;
 use crate::{Error, Vec3};
 

@@ -68,6 +68,23 @@ pub fn eval(d: [f64; 3], bands: usize) -> Vec<f64> {
     out
 }
 
+/// The zonal coefficients `∫_cap Y_l^0 dω`, `l < bands`, of the cap of half-angle `a`
+/// around `+z`, by Gauss–Kronrod quadrature of `2π·K_l^0·∫_0^a P_l(cos θ)·sin θ dθ` over
+/// panels a quarter of an oscillation wide (not the closed form the kernel uses).
+pub fn cap_zonal(a: f64, bands: usize) -> Vec<f64> {
+    let panels = (((bands + 1) as f64 * a / PI * 4.0).ceil() as usize).max(1);
+    (0..bands)
+        .map(|l| {
+            let mut f = |t: f64| legendre(l, 0, t.cos()) * t.sin();
+            let w = a / panels as f64;
+            let i: f64 = (0..panels)
+                .map(|k| crate::quad::gk15(&mut f, k as f64 * w, (k + 1) as f64 * w).0)
+                .sum();
+            2.0 * PI * normalisation(l, 0) * i
+        })
+        .collect()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
