@@ -138,6 +138,7 @@ pub fn coefficients_into(
 }
 
 #[cfg(all(test, feature = "alloc"))]
+#[allow(clippy::needless_range_loop)] // l indexes the kernel's and the reference's bands
 mod tests {
     use super::*;
     use crate::sh::eval_abs_error;
