@@ -6,7 +6,7 @@
 use serde_json::{Map, Value, json};
 use steradian_core::{Vec2, lobe, lobe::cap, rsl::hemisphere, sh};
 
-use crate::json::{bands, exponent, nonzero, num, number, scale, vector};
+use crate::json::{bands, element_f32, exponent, field, nonzero, num, number, scale, vector};
 
 /// `lobe-integral`: `{"exponent": e, "scale": s}` → `{"integral": 2πs/(e+1)}`.
 pub fn lobe_integral(obj: &Map<String, Value>) -> Result<Value, String> {
@@ -79,4 +79,29 @@ pub fn sh_cap(obj: &Map<String, Value>) -> Result<Value, String> {
     let mut c = vec![0.0f32; n * n];
     sh::cap::coefficients_into(d, a, n, &mut c).map_err(|e| e.to_string())?;
     Ok(json!({ "coeffs": c.into_iter().map(num).collect::<Vec<_>>() }))
+}
+
+/// `sh-irradiance`: `{"coeffs": [n² radiance coefficients], "normal": [x, y, z]}` →
+/// `{"irradiance": E}`, `E = ∫ L(ω)·max(n·ω, 0) dω` (not divided by π).
+pub fn sh_irradiance(obj: &Map<String, Value>) -> Result<Value, String> {
+    let list = field(obj, "coeffs")?
+        .as_array()
+        .ok_or_else(|| "coeffs must be an array of numbers".to_string())?;
+    let c: Vec<f32> = list
+        .iter()
+        .enumerate()
+        .map(|(i, v)| element_f32(v, &format!("coeffs[{i}]")))
+        .collect::<Result<_, _>>()?;
+    let n = (c.len() as f64).sqrt() as usize;
+    if n * n != c.len() || n == 0 || n > sh::MAX_BANDS {
+        return Err(format!(
+            "coeffs has {} values: not n² for a band count n in 1..={}",
+            c.len(),
+            sh::MAX_BANDS
+        ));
+    }
+    let normal = nonzero(vector::<3>(obj, "normal")?, "normal")?;
+    let mut scratch = vec![0.0f32; c.len()];
+    let e = sh::irradiance::irradiance(&c, normal, &mut scratch).map_err(|e| e.to_string())?;
+    Ok(json!({ "irradiance": num(e) }))
 }

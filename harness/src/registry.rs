@@ -377,6 +377,23 @@ pub const KERNELS: &[KernelSpec] = &[
         batch: None,
         tables: &[],
     },
+    KernelSpec {
+        name: "sh-irradiance",
+        paper: Paper::Sh,
+        contract: r#"{"coeffs": [n² radiance coefficients], "normal": [x,y,z] non-zero} -> {"irradiance": E = ∫ L·max(n·ω,0) dω (not /π)}"#,
+        eval: Piece::At(handlers::sh_irradiance),
+        scalar: "steradian_core::sh::irradiance::irradiance",
+        simd: Piece::Without("not written yet: one dot product per normal after sh-eval"),
+        wgsl: Piece::Without("not written yet (WGSL has no f64; see sh-eval)"),
+        reference: Piece::At("steradian_reference::sh::irradiance"),
+        bound: Piece::At(Bound {
+            metric: "abs per unit of Σ|L|",
+            item: "steradian_core::sh::irradiance::clamped_cosine",
+            value: Some(1e-6),
+        }),
+        batch: None,
+        tables: &[],
+    },
 ];
 
 /// The kernel named `name`.

@@ -84,6 +84,7 @@
 //!   Equation numbers in this folder are the arXiv version's.
 
 pub mod cap;
+pub mod irradiance;
 
 use crate::math;
 use crate::{Error, Vec3};

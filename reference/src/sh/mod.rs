@@ -85,6 +85,61 @@ pub fn cap_zonal(a: f64, bands: usize) -> Vec<f64> {
         .collect()
 }
 
+/// `A_l = 2π·∫_0^1 t·P_l(t) dt` by Gauss–Kronrod quadrature (panels of width 1/(l + 1)).
+pub fn clamped_cosine(l: usize) -> f64 {
+    let panels = l + 1;
+    let w = 1.0 / panels as f64;
+    let mut f = |t: f64| t * legendre(l, 0, t);
+    2.0 * PI
+        * (0..panels)
+            .map(|k| crate::quad::gk15(&mut f, k as f64 * w, (k + 1) as f64 * w).0)
+            .sum::<f64>()
+}
+
+/// `∫ L(ω)·max(n·ω, 0) dω` for the radiance with SH coefficients `coeffs` (`bands²`), by
+/// quadrature in the frame of `n`: Gauss–Kronrod in `t = n·ω` over 8 panels of `[0, 1]`
+/// and the midpoint rule over 128 azimuths (exact for band-limited radiance below 60 bands).
+pub fn irradiance(coeffs: &[f64], n: [f64; 3]) -> f64 {
+    let bands = (coeffs.len() as f64).sqrt().round() as usize;
+    let len = (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt();
+    let nz = [n[0] / len, n[1] / len, n[2] / len];
+    // A tangent frame (t1, t2, nz).
+    let a = if nz[0].abs() < 0.9 {
+        [1.0, 0.0, 0.0]
+    } else {
+        [0.0, 1.0, 0.0]
+    };
+    let cross = |p: [f64; 3], q: [f64; 3]| {
+        [
+            p[1] * q[2] - p[2] * q[1],
+            p[2] * q[0] - p[0] * q[2],
+            p[0] * q[1] - p[1] * q[0],
+        ]
+    };
+    let t1 = cross(a, nz);
+    let l1 = (t1[0] * t1[0] + t1[1] * t1[1] + t1[2] * t1[2]).sqrt();
+    let t1 = t1.map(|c| c / l1);
+    let t2 = cross(nz, t1);
+    let nphi = 128;
+    let mut ring = |t: f64| {
+        let s = (1.0 - t * t).max(0.0).sqrt();
+        let mut acc = 0.0;
+        for j in 0..nphi {
+            let p = (j as f64 + 0.5) * 2.0 * PI / nphi as f64;
+            let (c, sn) = (p.cos(), p.sin());
+            let d: [f64; 3] = std::array::from_fn(|i| s * (c * t1[i] + sn * t2[i]) + t * nz[i]);
+            let y = eval(d, bands);
+            acc += y.iter().zip(coeffs).map(|(y, c)| y * c).sum::<f64>();
+        }
+        t * acc * 2.0 * PI / nphi as f64
+    };
+    let panels = 8;
+    let w = 1.0 / panels as f64;
+    (0..panels)
+        .map(|k| crate::quad::gk15(&mut ring, k as f64 * w, (k + 1) as f64 * w).0)
+        .sum()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
