@@ -7,6 +7,7 @@ mod common;
 mod coverage;
 mod cycles;
 mod env;
+mod fuzz_replay;
 mod gpu;
 mod lobe_sum;
 mod product;
