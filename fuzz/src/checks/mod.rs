@@ -8,6 +8,7 @@ pub mod lobe_product;
 pub mod map_roundtrip;
 pub mod moments_kernel;
 pub mod sat_query;
+pub mod sh;
 pub mod simd_vs_scalar;
 pub mod table_lookup;
 pub mod vdt;
@@ -16,12 +17,13 @@ pub mod vdt;
 pub type Check = fn(&[u8]);
 
 /// Every target, by name (the corpus folder).
-pub const TARGETS: [(&str, Check); 8] = [
+pub const TARGETS: [(&str, Check); 9] = [
     ("eval_lines", eval_lines::check),
     ("lobe_product", lobe_product::check),
     ("map_roundtrip", map_roundtrip::check),
     ("moments_kernel", moments_kernel::check),
     ("sat_query", sat_query::check),
+    ("sh", sh::check),
     ("simd_vs_scalar", simd_vs_scalar::check),
     ("table_lookup", table_lookup::check),
     ("vdt", vdt::check),

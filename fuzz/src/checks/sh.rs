@@ -1,0 +1,61 @@
+//! Spherical harmonics on arbitrary bits: the SIMD evaluation equals the scalar one bit for
+//! bit for any direction (NaN, ±∞, subnormal components included) at 1–12 bands; every value
+//! is finite for every finite non-zero direction; the cap coefficients are finite for any
+//! finite direction and any half-angle in `[0, π]` (an error outside, never a panic); the
+//! irradiance of finite coefficients at a finite normal is finite.
+
+use steradian_core::{Vec3, sh};
+
+fn f32_at(d: &[u8], at: usize) -> f32 {
+    let b: [u8; 4] = core::array::from_fn(|k| d.get(at + k).copied().unwrap_or(0));
+    f32::from_le_bytes(b)
+}
+
+/// The target's checks on one input.
+pub fn check(data: &[u8]) {
+    if data.is_empty() {
+        return;
+    }
+    let bands = 1 + (data[0] % 12) as usize;
+    let rest = &data[1..];
+    let dirs: Vec<Vec3> = (0..4)
+        .map(|k| {
+            Vec3::new(
+                f32_at(rest, 12 * k),
+                f32_at(rest, 12 * k + 4),
+                f32_at(rest, 12 * k + 8),
+            )
+        })
+        .collect();
+    let x: Vec<f32> = dirs.iter().map(|d| d.x).collect();
+    let y: Vec<f32> = dirs.iter().map(|d| d.y).collect();
+    let z: Vec<f32> = dirs.iter().map(|d| d.z).collect();
+    let n = bands * bands;
+    let mut cols = vec![0.0f32; n * 4];
+    steradian_simd::sh::eval_slices(&x, &y, &z, bands, &mut cols).expect("valid shapes");
+    let mut one = vec![0.0f32; n];
+    for (i, d) in dirs.iter().enumerate() {
+        sh::eval_into(*d, bands, &mut one).expect("valid band count");
+        for k in 0..n {
+            let (a, b) = (cols[k * 4 + i], one[k]);
+            assert!(
+                a.to_bits() == b.to_bits() || (a.is_nan() && b.is_nan()),
+                "{d} k {k}: {a} vs {b}"
+            );
+        }
+        if d.is_finite() {
+            assert!(one.iter().all(|v| v.is_finite()), "{d}: non-finite SH");
+            let a = f32_at(rest, 48);
+            let mut c = vec![0.0f32; n];
+            match sh::cap::coefficients_into(*d, a, bands, &mut c) {
+                Ok(()) => assert!(c.iter().all(|v| v.is_finite()), "cap {a}: non-finite"),
+                Err(_) => assert!(!(0.0..=steradian_core::PI).contains(&a)),
+            }
+            if one.iter().all(|v| v.abs() < 1e30) {
+                let mut scratch = vec![0.0f32; n];
+                let e = sh::irradiance::irradiance(&one, *d, &mut scratch).expect("square length");
+                assert!(e.is_finite(), "irradiance of finite coefficients: {e}");
+            }
+        }
+    }
+}
