@@ -23,24 +23,7 @@ pub fn direction_at(a: [f64; 3], theta: f64, phi: f64) -> [f64; 3] {
     })
 }
 
-fn perpendiculars(a: [f64; 3]) -> ([f64; 3], [f64; 3]) {
-    let t = if a[0].abs() < 0.9 {
-        [1.0, 0.0, 0.0]
-    } else {
-        [0.0, 1.0, 0.0]
-    };
-    let cross = |p: [f64; 3], q: [f64; 3]| {
-        [
-            p[1] * q[2] - p[2] * q[1],
-            p[2] * q[0] - p[0] * q[2],
-            p[0] * q[1] - p[1] * q[0],
-        ]
-    };
-    let u = cross(a, t);
-    let l = (u[0] * u[0] + u[1] * u[1] + u[2] * u[2]).sqrt();
-    let u = u.map(|c| c / l);
-    (u, cross(a, u))
-}
+use steradian_reference::perpendiculars;
 
 /// `n` rows for `kernel`: the hard cases, then random rows from `seed`.
 pub fn generate(kernel: Kernel, n: usize, seed: u64) -> Columns {

@@ -539,5 +539,6 @@ fn gradient_variant_against_exact_distance_eq9_on_oblique_edges() {
         "oblique edges: gradient {g:.4e}, eq. 9 on the exact distance {e9:.4e}, ratio {ratio:.3}"
     );
     assert!((0.016..0.019).contains(&e9), "{e9}");
+    assert!((0.022..0.026).contains(&g), "{g}");
     assert!(ratio < 1.45, "{ratio}");
 }

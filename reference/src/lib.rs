@@ -16,3 +16,24 @@ pub mod lobe;
 pub mod quad;
 pub mod rsl;
 pub mod sh;
+
+/// Two unit vectors completing the unit `a` to a right-handed frame `(u, w, a)`: `u` is
+/// `a × x̂` (or `a × ŷ` when `a` is within 26° of `x̂`), normalised, and `w = a × u`.
+pub fn perpendiculars(a: [f64; 3]) -> ([f64; 3], [f64; 3]) {
+    let t = if a[0].abs() < 0.9 {
+        [1.0, 0.0, 0.0]
+    } else {
+        [0.0, 1.0, 0.0]
+    };
+    let cross = |p: [f64; 3], q: [f64; 3]| {
+        [
+            p[1] * q[2] - p[2] * q[1],
+            p[2] * q[0] - p[0] * q[2],
+            p[0] * q[1] - p[1] * q[0],
+        ]
+    };
+    let u = cross(a, t);
+    let l = (u[0] * u[0] + u[1] * u[1] + u[2] * u[2]).sqrt();
+    let u = u.map(|c| c / l);
+    (u, cross(a, u))
+}

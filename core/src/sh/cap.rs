@@ -38,7 +38,7 @@
 //! [`crate::sh::eval_into`] (any length; zero → `+z`).
 
 use crate::math;
-use crate::sh::{MAX_BANDS, eval_into};
+use crate::sh::{check_shape, eval_into};
 use crate::{Error, Vec3};
 
 /// Relative error bound of [`zonal_into`] per coefficient (`f32` rounding of the `f64`
@@ -59,14 +59,9 @@ fn check(half_angle: f32, bands: usize, len: usize, need: usize) -> Result<(), E
             max: crate::PI,
         });
     }
-    if bands > MAX_BANDS {
-        return Err(Error::OutOfRange {
-            what: "SH bands",
-            value: bands as f32,
-            min: 0.0,
-            max: MAX_BANDS as f32,
-        });
-    }
+    // The band limit as every SH entry point checks it; the output length against `need`
+    // (`bands` zonal or `bands²` full coefficients).
+    check_shape(bands, usize::MAX)?;
     if len < need {
         return Err(Error::OutOfRange {
             what: "SH output length",
@@ -141,7 +136,7 @@ pub fn coefficients_into(
 #[allow(clippy::needless_range_loop)] // l indexes the kernel's and the reference's bands
 mod tests {
     use super::*;
-    use crate::sh::eval_abs_error;
+    use crate::sh::{MAX_BANDS, eval_abs_error};
     use alloc::vec;
     use steradian_reference::sh as reference;
 

@@ -103,23 +103,7 @@ pub fn irradiance(coeffs: &[f64], n: [f64; 3]) -> f64 {
     let bands = (coeffs.len() as f64).sqrt().round() as usize;
     let len = (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt();
     let nz = [n[0] / len, n[1] / len, n[2] / len];
-    // A tangent frame (t1, t2, nz).
-    let a = if nz[0].abs() < 0.9 {
-        [1.0, 0.0, 0.0]
-    } else {
-        [0.0, 1.0, 0.0]
-    };
-    let cross = |p: [f64; 3], q: [f64; 3]| {
-        [
-            p[1] * q[2] - p[2] * q[1],
-            p[2] * q[0] - p[0] * q[2],
-            p[0] * q[1] - p[1] * q[0],
-        ]
-    };
-    let t1 = cross(a, nz);
-    let l1 = (t1[0] * t1[0] + t1[1] * t1[1] + t1[2] * t1[2]).sqrt();
-    let t1 = t1.map(|c| c / l1);
-    let t2 = cross(nz, t1);
+    let (t1, t2) = crate::perpendiculars(nz);
     let nphi = 128;
     let mut ring = |t: f64| {
         let s = (1.0 - t * t).max(0.0).sqrt();

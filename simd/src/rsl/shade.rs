@@ -263,12 +263,7 @@ fn vdt_lanes(
     let rr = sel(r.simd_lt(rmin), rmin, sel(r.simd_gt(rmax), rmax, r));
     let sqrt2 = f32x8::splat(core::f32::consts::SQRT_2);
     match query {
-        VdtQuery::Eq9 => {
-            // Eq. 9, `steradian_core::rsl::vdt::eq9_from` operation for operation.
-            let k = sqrt2 * rr;
-            let e = (f32x8::splat(0.5) * k + dd) / k;
-            sel(e.simd_lt(zero), zero, sel(e.simd_gt(one), one, e))
-        }
+        VdtQuery::Eq9 => crate::rsl::vdt::eq9_lanes(dd, rr),
         VdtQuery::Gradient => {
             let gx = lerp(d10 - d00, d11 - d01, fy).abs();
             let gy = lerp(d01 - d00, d11 - d10, fx).abs();

@@ -35,6 +35,15 @@ fn lerp<W: Lanes>(a: W, b: W, t: W) -> W {
     (W::splat(1.0) - t) * a + t * b
 }
 
+/// Eq. 9 lane-wise, `steradian_core::rsl::vdt::eq9_from` operation for operation, for a
+/// half-diagonal `rr` already clamped to `[R_MIN, R_MAX]` (the one copy the VDT query and
+/// the SIMD shading kernel share).
+#[inline(always)]
+pub(crate) fn eq9_lanes<W: Lanes>(dd: W, rr: W) -> W {
+    let k = W::splat(SQRT_2) * rr;
+    clamp((W::splat(0.5) * k + dd) / k, W::splat(0.0), W::splat(1.0))
+}
+
 /// The scalar `VdtView::query`, operation for operation: `[eq9, gradient]`.
 #[inline(always)]
 fn query_lanes<W: Lanes>(view: &VdtView<'_>, [u, v, r]: [W; 3]) -> [W; 2] {
@@ -65,9 +74,7 @@ fn query_lanes<W: Lanes>(view: &VdtView<'_>, [u, v, r]: [W; 3]) -> [W; 2] {
     let zero = W::splat(0.0);
     let one = W::splat(1.0);
     let rr = clamp(r, W::splat(R_MIN), W::splat(R_MAX));
-    // Eq. 9.
-    let k = W::splat(SQRT_2) * rr;
-    let e9 = clamp((W::splat(0.5) * k + dd) / k, zero, one);
+    let e9 = eq9_lanes(dd, rr);
     // Straight-edge fraction.
     let (ax, ay) = (gx.abs(), gy.abs());
     let m = max_num(ax, ay);

@@ -11,7 +11,7 @@
 //!
 //! Those of `steradian_core::sh` (the HVL paper, eq. 7–8).
 
-use steradian_core::sh::{A, B, DIAG, MAX_BANDS, SUB, Y00, tri, unit_direction};
+use steradian_core::sh::{A, B, DIAG, SUB, Y00, check_shape, tri, unit_direction};
 use steradian_core::{Error, Vec3};
 use wide::f64x4;
 
@@ -21,33 +21,13 @@ use wide::f64x4;
 ///
 /// Errors: `bands > MAX_BANDS` or `out` shorter than `bands²`.
 pub fn eval_x4(dirs: [Vec3; 4], bands: usize, out: &mut [[f32; 4]]) -> Result<(), Error> {
-    check(bands, out.len())?;
+    check_shape(bands, out.len())?;
     let u = dirs.map(unit_direction);
     let mut put = |k: usize, v: f64x4| out[k] = v.to_array().map(|x| x as f32);
     fill(u, bands, &mut put);
     // The first coefficient is written in f32 like the scalar kernel's (`Y00 + 0·z`).
     if bands > 0 {
         out[0] = u.map(|d| Y00 + 0.0 * d.z);
-    }
-    Ok(())
-}
-
-fn check(bands: usize, len: usize) -> Result<(), Error> {
-    if bands > MAX_BANDS {
-        return Err(Error::OutOfRange {
-            what: "SH bands",
-            value: bands as f32,
-            min: 0.0,
-            max: MAX_BANDS as f32,
-        });
-    }
-    if len < bands * bands {
-        return Err(Error::OutOfRange {
-            what: "SH output length",
-            value: len as f32,
-            min: (bands * bands) as f32,
-            max: f32::INFINITY,
-        });
     }
     Ok(())
 }
@@ -112,7 +92,7 @@ pub fn eval_slices(
     out: &mut [f32],
 ) -> Result<(), Error> {
     let len = x.len();
-    check(bands, usize::MAX)?;
+    check_shape(bands, usize::MAX)?;
     if y.len() != len || z.len() != len || out.len() != bands * bands * len {
         return Err(Error::OutOfRange {
             what: "SH column length",
