@@ -34,6 +34,14 @@ pub enum Error {
         /// Radius of the sphere.
         radius: f32,
     },
+    /// A matrix given as a rotation is not one: `max |RᵀR − I|` above `1e-5`, or not
+    /// orientation-preserving.
+    NotRotation {
+        /// `max |RᵀR − I|` over the entries.
+        orthogonality: f32,
+        /// `det R` (must be positive).
+        determinant: f32,
+    },
     /// Table bytes failed validation.
     Table(crate::table::TableError),
 }
@@ -52,6 +60,13 @@ impl fmt::Display for Error {
             Error::InsideSphere { distance, radius } => write!(
                 f,
                 "the point is inside the sphere (distance {distance} to the centre, radius {radius})"
+            ),
+            Error::NotRotation {
+                orthogonality,
+                determinant,
+            } => write!(
+                f,
+                "not a proper rotation: max |RᵀR − I| = {orthogonality} (at most 1e-5), det = {determinant} (must be > 0)"
             ),
             Error::Table(e) => write!(f, "table: {e}"),
         }

@@ -6,7 +6,7 @@
 use serde_json::{Map, Value, json};
 use steradian_core::{Vec2, lobe, lobe::cap, rsl::hemisphere, sh};
 
-use crate::json::{bands, element_f32, exponent, field, nonzero, num, number, scale, vector};
+use crate::json::{bands, exponent, matrix3, nonzero, num, number, scale, sh_coeffs, vector};
 
 /// `lobe-integral`: `{"exponent": e, "scale": s}` → `{"integral": 2πs/(e+1)}`.
 pub fn lobe_integral(obj: &Map<String, Value>) -> Result<Value, String> {
@@ -84,24 +84,23 @@ pub fn sh_cap(obj: &Map<String, Value>) -> Result<Value, String> {
 /// `sh-irradiance`: `{"coeffs": [n² radiance coefficients], "normal": [x, y, z]}` →
 /// `{"irradiance": E}`, `E = ∫ L(ω)·max(n·ω, 0) dω` (not divided by π).
 pub fn sh_irradiance(obj: &Map<String, Value>) -> Result<Value, String> {
-    let list = field(obj, "coeffs")?
-        .as_array()
-        .ok_or_else(|| "coeffs must be an array of numbers".to_string())?;
-    let c: Vec<f32> = list
-        .iter()
-        .enumerate()
-        .map(|(i, v)| element_f32(v, &format!("coeffs[{i}]")))
-        .collect::<Result<_, _>>()?;
-    let n = (c.len() as f64).sqrt() as usize;
-    if n * n != c.len() || n == 0 || n > sh::MAX_BANDS {
-        return Err(format!(
-            "coeffs has {} values: not n² for a band count n in 1..={}",
-            c.len(),
-            sh::MAX_BANDS
-        ));
-    }
+    let (c, _) = sh_coeffs(obj, sh::MAX_BANDS)?;
     let normal = nonzero(vector::<3>(obj, "normal")?, "normal")?;
     let mut scratch = vec![0.0f32; c.len()];
     let e = sh::irradiance::irradiance(&c, normal, &mut scratch).map_err(|e| e.to_string())?;
     Ok(json!({ "irradiance": num(e) }))
+}
+
+/// `sh-rotate`: `{"coeffs": [n² values], "rotation": [[r00, r01, r02], [r10, …], […]]}`
+/// (rows; `max |RᵀR − I| ≤ 1e-5` and `det R > 0`) → `{"coeffs": [n² values]}` of
+/// `g(ω) = f(Rᵀω)`, by the ZXZXZ path.
+pub fn sh_rotate(obj: &Map<String, Value>) -> Result<Value, String> {
+    let (c, n) = sh_coeffs(obj, sh::MAX_BANDS)?;
+    let rot = sh::rotate::Rotation::new(matrix3(obj, "rotation")?).map_err(|e| e.to_string())?;
+    let rotator = sh::rotate::Rotator::new(n).map_err(|e| e.to_string())?;
+    let mut out = vec![0.0f32; c.len()];
+    rotator
+        .rotate(&rot, &c, &mut out)
+        .map_err(|e| e.to_string())?;
+    Ok(json!({ "coeffs": out.into_iter().map(num).collect::<Vec<_>>() }))
 }

@@ -119,3 +119,44 @@ pub fn element_f32(v: &Value, what: &str) -> Result<f32, String> {
         |x| format!("{what} = {x} is not a finite f32"),
     )
 }
+
+/// Field `"coeffs"` as an SH coefficient vector: finite `f32`s, `n²` of them for a band count
+/// `n` in `1..=max`. Returns the values and `n`.
+pub fn sh_coeffs(obj: &Map<String, Value>, max: usize) -> Result<(Vec<f32>, usize), String> {
+    let list = field(obj, "coeffs")?
+        .as_array()
+        .ok_or_else(|| "coeffs must be an array of numbers".to_string())?;
+    let c: Vec<f32> = list
+        .iter()
+        .enumerate()
+        .map(|(i, v)| element_f32(v, &format!("coeffs[{i}]")))
+        .collect::<Result<_, _>>()?;
+    let n = (c.len() as f64).sqrt() as usize;
+    if n * n != c.len() || n == 0 || n > max {
+        return Err(format!(
+            "coeffs has {} values: not n² for a band count n in 1..={max}",
+            c.len()
+        ));
+    }
+    Ok((c, n))
+}
+
+/// Field `name` as a 3×3 matrix given by rows, `[[r00, r01, r02], [r10, …], […]]`, of finite
+/// `f32`s.
+pub fn matrix3(obj: &Map<String, Value>, name: &str) -> Result<[[f32; 3]; 3], String> {
+    let rows = field(obj, name)?
+        .as_array()
+        .filter(|r| r.len() == 3)
+        .ok_or_else(|| format!("field \"{name}\" must be 3 rows of 3 numbers"))?;
+    let mut out = [[0.0f32; 3]; 3];
+    for (i, (o, row)) in out.iter_mut().zip(rows).enumerate() {
+        let row = row
+            .as_array()
+            .filter(|r| r.len() == 3)
+            .ok_or_else(|| format!("{name}[{i}] must be a row of 3 numbers"))?;
+        for (j, (e, v)) in o.iter_mut().zip(row).enumerate() {
+            *e = element_f32(v, &format!("{name}[{i}][{j}]"))?;
+        }
+    }
+    Ok(out)
+}

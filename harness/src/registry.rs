@@ -394,6 +394,25 @@ pub const KERNELS: &[KernelSpec] = &[
         batch: None,
         tables: &[],
     },
+    KernelSpec {
+        name: "sh-rotate",
+        paper: Paper::Sh,
+        contract: r#"{"coeffs": [n² values], "rotation": [[r00,r01,r02],[r10,r11,r12],[r20,r21,r22]] rows, max|RᵀR−I| ≤ 1e-5, det > 0} -> {"coeffs": [n² values of g(ω) = f(Rᵀω)]}"#,
+        eval: Piece::At(handlers::sh_rotate),
+        scalar: "steradian_core::sh::rotate::rotate_zxzxz",
+        simd: Piece::Without(
+            "not written yet: the built operator applied to 8 vectors per lane set",
+        ),
+        wgsl: Piece::Without("not written yet"),
+        reference: Piece::At("steradian_reference::sh::rotate"),
+        bound: Piece::At(Bound {
+            metric: "‖error‖/‖c‖",
+            item: "steradian_core::sh::rotate::rotate_rel_error",
+            value: Some(4e-7),
+        }),
+        batch: None,
+        tables: &[],
+    },
 ];
 
 /// The kernel named `name`.

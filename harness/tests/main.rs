@@ -14,6 +14,7 @@ mod product;
 mod product_gpu;
 mod properties;
 mod sat;
+mod sh;
 mod shade;
 mod shade_moments_gpu;
 mod vdt;

@@ -34,7 +34,7 @@
 //! ```
 //!
 //! The coefficients are computed in `f64` at compile time ([`A`], [`B`], [`DIAG`], [`SUB`]:
-//! no table file, no square root at run time) and rounded once to `f32`. The recurrence
+//! no table file, no square root at run time) and kept in `f64`. The recurrence
 //! itself runs in its homogeneous form, `Π_l^m = a_l^m·(z·Π_{l−1}^m − b_l^m·r²·Π_{l−2}^m)`
 //! with `r² = x² + y² + z²` of the given point, so that an `f32` unit vector's distance from
 //! the sphere (a few `1e-8`) scales band `l` by `r^l` instead of being amplified by the
@@ -44,12 +44,14 @@
 //! normalisation of the direction.
 //!
 //! **Precision: `f64` inside, `f32` in and out.** The crate's kernels compute in `f32`; this
-//! one runs its recurrence in `f64` on the `f32` inputs and coefficients and rounds each
-//! output once. In `f32` the rounding errors of the three-term recurrence grow like `l²`
-//! (measured `3.1e-5` at band 29, `1e-5` only through band 17), which misses the `1e-5`
-//! target; in `f64` they are negligible and what remains is the `f32` rounding of the
-//! direction and of the coefficients (`4.1e-6` at band 29). On x86-64 and AArch64 a scalar
-//! `f64` multiply-add costs what an `f32` one does.
+//! one normalises the `f32` direction in `f64`, runs its recurrence in `f64` with `f64`
+//! coefficients and rounds each output once. In `f32` the rounding errors of the
+//! three-term recurrence grow like `l²` (measured `3.1e-5` at band 29, `1e-5` only through
+//! band 17), which misses the `1e-5` target; an `f32` normalisation of the direction alone
+//! (an angular error of `6e-8`, times the slope `~l·|Y|`) costs `3e-6` at band 29, and `f32`
+//! coefficients another `1e-6`. In `f64` all three are negligible and what remains is the
+//! rounding of the output (`1.1e-7` through band 29). On x86-64 and AArch64 a scalar `f64`
+//! multiply-add costs what an `f32` one does.
 //!
 //! **Exact cases.** At the poles (`x = y = 0`) every `C_m`, `S_m` with `m ≥ 1` is exactly 0,
 //! so every `m ≠ 0` function is exactly 0; at the equator (`z = 0`) the recurrence gives
@@ -66,8 +68,8 @@
 //! normalisation, the unnormalised recurrence, `cos(mφ)` from `atan2`) at the exact
 //! direction of the input, over 2000 random directions and the hard cases (poles, equator,
 //! 1e-7 from the poles), the largest absolute error in band `l` is within
-//! [`eval_abs_error`]`(l) = 2e-7·(l + 1)`: below `1e-5` through 30 bands (tests in this
-//! module; measured 1.1e-6 at band 10, 4.1e-6 at band 29).
+//! [`eval_abs_error`]`(l) = 1e-7 + 1e-8·l`: below `4e-7` through 30 bands (tests in this
+//! module; measured 6e-8 at band 10, 1.1e-7 at band 28).
 //!
 //! ## Bad input
 //!
@@ -85,15 +87,20 @@
 
 pub mod cap;
 pub mod irradiance;
+pub mod rotate;
 
 use crate::math;
 use crate::{Error, Vec3};
+use glam::DVec3;
 
 /// Largest band count the recurrence tables cover (`MAX_BANDS²` = 16 384 coefficients).
 pub const MAX_BANDS: usize = 128;
 
 /// `Y_0^0 = 1/√(4π)`.
 pub const Y00: f32 = 0.282_094_8;
+
+/// `Y_0^0 = 1/√(4π)` in `f64`, the recurrence's start.
+pub const Y00_F64: f64 = 0.282_094_791_773_878_14;
 
 /// The flat index `l² + l + m` of `Y_l^m` (`|m| ≤ l`).
 #[inline]
@@ -108,17 +115,20 @@ pub const fn coefficients(bands: usize) -> usize {
 }
 
 /// The largest absolute error of [`eval_into`] in band `l` against the `f64` reference at
-/// the exact direction of the input (module docs): `2e-7·(l + 1)`, so below `1e-5` through
-/// 30 bands (measured: 1.5e-8 at `l = 0`, 1.1e-6 at 10, 4.1e-6 at 29). Tested per band.
+/// the exact direction of the input (module docs): `1e-7 + 1e-8·l`, so `4e-7` at band 29,
+/// 25× inside the `1e-5` the kernel is asked for (measured: 1.5e-8 at `l = 0`, 6e-8 at 10,
+/// 1.1e-7 at 28; the `f32` rounding of the output is most of it). Tested per band.
 pub fn eval_abs_error(l: usize) -> f32 {
-    2.0e-7 * (l + 1) as f32
+    1.0e-7 + 1.0e-8 * l as f32
 }
 
 // ---- Compile-time coefficients -----------------------------------------------------------
 
-/// `√x` for `x ≥ 0` in a `const` context: Newton's iteration from the exponent-halved
-/// guess, then the last ulp settled by comparing the squares of the neighbours (the result
-/// is within half an `f64` ulp; tested against `f64::sqrt` for every table entry).
+/// `√x` for `x ≥ 0` in a `const` context, correctly rounded: Newton's iteration from the
+/// exponent-halved guess, then the last ulp settled by the exact residual `x − r²` (Dekker's
+/// exact square): `r` is the rounding of `√x` exactly when `x` lies between the squares of
+/// the midpoints `r ± u/2`, i.e. `−(r·u⁻ − u⁻²/4) ≤ x − r² ≤ r·u + u²/4` (`u`, `u⁻` the ulps
+/// above and below `r`). Tested against `f64::sqrt` for every table entry.
 const fn sqrt_const(x: f64) -> f64 {
     if x <= 0.0 {
         return 0.0;
@@ -131,23 +141,31 @@ const fn sqrt_const(x: f64) -> f64 {
         r = 0.5 * (r + x / r);
         k += 1;
     }
-    // Choose the neighbour whose square is closest to x.
-    let lo = f64::from_bits(r.to_bits() - 1);
-    let hi = f64::from_bits(r.to_bits() + 1);
-    let (dl, dr, dh) = (sq_dist(lo, x), sq_dist(r, x), sq_dist(hi, x));
-    if dl < dr && dl <= dh {
-        lo
-    } else if dh < dr {
-        hi
-    } else {
-        r
+    let mut k = 0;
+    while k < 4 {
+        let e = residual(x, r);
+        let up = f64::from_bits(r.to_bits() + 1) - r;
+        let down = r - f64::from_bits(r.to_bits() - 1);
+        if e > r * up + 0.25 * up * up {
+            r += up;
+        } else if -e > r * down - 0.25 * down * down {
+            r -= down;
+        } else {
+            break;
+        }
+        k += 1;
     }
+    r
 }
 
-/// `|v² − x|`.
-const fn sq_dist(v: f64, x: f64) -> f64 {
-    let e = v * v - x;
-    if e < 0.0 { -e } else { e }
+/// `x − r²` with `r²` formed exactly as `p + q` (Dekker's split into 26-bit halves).
+const fn residual(x: f64, r: f64) -> f64 {
+    let c = 134_217_729.0 * r; // 2^27 + 1
+    let hi = c - (c - r);
+    let lo = r - hi;
+    let p = r * r;
+    let q = ((hi * hi - p) + 2.0 * hi * lo) + lo * lo;
+    (x - p) - q
 }
 
 /// Entries of a lower-triangular `(l, m)` table, `0 ≤ m ≤ l < MAX_BANDS`.
@@ -159,14 +177,14 @@ pub const fn tri(l: usize, m: usize) -> usize {
     l * (l + 1) / 2 + m
 }
 
-const fn table_a() -> [f32; TRI] {
-    let mut t = [0.0f32; TRI];
+const fn table_a() -> [f64; TRI] {
+    let mut t = [0.0f64; TRI];
     let mut l = 2;
     while l < MAX_BANDS {
         let mut m = 0;
         while m + 2 <= l {
             let (lf, mf) = (l as f64, m as f64);
-            t[tri(l, m)] = sqrt_const((4.0 * lf * lf - 1.0) / (lf * lf - mf * mf)) as f32;
+            t[tri(l, m)] = sqrt_const((4.0 * lf * lf - 1.0) / (lf * lf - mf * mf));
             m += 1;
         }
         l += 1;
@@ -174,14 +192,14 @@ const fn table_a() -> [f32; TRI] {
     t
 }
 
-const fn table_b() -> [f32; TRI] {
-    let mut t = [0.0f32; TRI];
+const fn table_b() -> [f64; TRI] {
+    let mut t = [0.0f64; TRI];
     let mut l = 2;
     while l < MAX_BANDS {
         let mut m = 0;
         while m + 2 <= l {
             let (l1, mf) = ((l - 1) as f64, m as f64);
-            t[tri(l, m)] = sqrt_const((l1 * l1 - mf * mf) / (4.0 * l1 * l1 - 1.0)) as f32;
+            t[tri(l, m)] = sqrt_const((l1 * l1 - mf * mf) / (4.0 * l1 * l1 - 1.0));
             m += 1;
         }
         l += 1;
@@ -189,51 +207,53 @@ const fn table_b() -> [f32; TRI] {
     t
 }
 
-const fn table_diag() -> [f32; MAX_BANDS] {
-    let mut t = [0.0f32; MAX_BANDS];
+const fn table_diag() -> [f64; MAX_BANDS] {
+    let mut t = [0.0f64; MAX_BANDS];
     let mut m = 1;
     while m < MAX_BANDS {
         let mf = m as f64;
-        t[m] = -sqrt_const((2.0 * mf + 1.0) / (2.0 * mf)) as f32;
+        t[m] = -sqrt_const((2.0 * mf + 1.0) / (2.0 * mf));
         m += 1;
     }
     t
 }
 
-const fn table_sub() -> [f32; MAX_BANDS] {
-    let mut t = [0.0f32; MAX_BANDS];
+const fn table_sub() -> [f64; MAX_BANDS] {
+    let mut t = [0.0f64; MAX_BANDS];
     let mut m = 0;
     while m < MAX_BANDS {
-        t[m] = sqrt_const(2.0 * m as f64 + 3.0) as f32;
+        t[m] = sqrt_const(2.0 * m as f64 + 3.0);
         m += 1;
     }
     t
 }
 
 /// `a_l^m = √((4l²−1)/(l²−m²))` at `tri(l, m)` for `l ≥ m + 2` (0 elsewhere).
-pub static A: [f32; TRI] = table_a();
+pub static A: [f64; TRI] = table_a();
 /// `b_l^m = √(((l−1)²−m²)/(4(l−1)²−1))` at `tri(l, m)` for `l ≥ m + 2` (0 elsewhere).
-pub static B: [f32; TRI] = table_b();
+pub static B: [f64; TRI] = table_b();
 /// `−√((2m+1)/(2m))` at `m ≥ 1`: `Π_m^m = DIAG[m]·Π_{m−1}^{m−1}`.
-pub static DIAG: [f32; MAX_BANDS] = table_diag();
+pub static DIAG: [f64; MAX_BANDS] = table_diag();
 /// `√(2m+3)`: `Π_{m+1}^m = SUB[m]·z·Π_m^m`.
-pub static SUB: [f32; MAX_BANDS] = table_sub();
+pub static SUB: [f64; MAX_BANDS] = table_sub();
 
 // ---- Evaluation --------------------------------------------------------------------------
 
-/// `d` scaled by its largest component and normalised; the zero vector → `+z`; NaN for a
+/// `d` scaled by its largest component and normalised, in `f64` (so the direction the
+/// recurrence sees is the input's to `1e-16`, not to the `6e-8` of an `f32` unit vector,
+/// which alone would cost `3e-6` at 30 bands); the zero vector → `+z`; NaN for a
 /// non-finite component.
 #[inline]
-pub fn unit_direction(d: Vec3) -> Vec3 {
-    let m = d.x.abs().max(d.y.abs()).max(d.z.abs());
+pub fn unit_direction(d: Vec3) -> DVec3 {
     if !d.is_finite() {
-        return Vec3::splat(f32::NAN);
+        return DVec3::splat(f64::NAN);
     }
+    let m = d.x.abs().max(d.y.abs()).max(d.z.abs());
     if m == 0.0 {
-        return Vec3::Z;
+        return DVec3::Z;
     }
-    let s = d / m;
-    s / math::sqrtf(s.dot(s))
+    let s = d.as_dvec3() / f64::from(m);
+    s / math::sqrt64(s.dot(s))
 }
 
 /// The recurrence over `bands` bands at the direction `d` (unit to `f32` rounding) into
@@ -246,32 +266,32 @@ pub fn unit_direction(d: Vec3) -> Vec3 {
 /// the point's distance from the sphere (a few `1e-8` for an `f32` unit vector) only scales
 /// band `l` by `r^l` instead of being amplified by the Legendre coefficients.
 #[inline(always)]
-fn fill(d: Vec3, bands: usize, out: &mut [f32]) {
+fn fill(d: DVec3, bands: usize, out: &mut [f32]) {
     let out = &mut out[..bands * bands];
     if bands == 0 {
         return;
     }
     // `+ 0·z`: NaN for a NaN direction (crate convention), exactly `Y00` otherwise.
-    out[0] = Y00 + 0.0 * d.z;
+    out[0] = (Y00_F64 + 0.0 * d.z) as f32;
     if bands == 1 {
         return;
     }
-    let (x, y, z) = (f64::from(d.x), f64::from(d.y), f64::from(d.z));
+    let (x, y, z) = (d.x, d.y, d.z);
     let r2 = x * x + y * y + z * z;
-    let y00 = f64::from(Y00);
+    let y00 = Y00_F64;
     // m = 0: Π_l^0 directly.
-    let (mut p2, mut p1) = (y00, f64::from(SUB[0]) * z * y00);
+    let (mut p2, mut p1) = (y00, SUB[0] * z * y00);
     out[2] = p1 as f32;
     for l in 2..bands {
         let k = tri(l, 0);
-        let p = f64::from(A[k]) * (z * p1 - f64::from(B[k]) * r2 * p2);
+        let p = A[k] * (z * p1 - B[k] * r2 * p2);
         out[l * l + l] = p as f32;
         (p2, p1) = (p1, p);
     }
     // m ≥ 1: √2·Π_l^m times C_m and S_m.
     let (mut pmm, mut c, mut s) = (y00, 1.0f64, 0.0f64);
     for m in 1..bands {
-        pmm *= f64::from(DIAG[m]);
+        pmm *= DIAG[m];
         (c, s) = (x * c - y * s, x * s + y * c);
         let mut q2 = core::f64::consts::SQRT_2 * pmm;
         let at = m * m + m;
@@ -280,13 +300,13 @@ fn fill(d: Vec3, bands: usize, out: &mut [f32]) {
         if m + 1 == bands {
             break;
         }
-        let mut q1 = f64::from(SUB[m]) * z * q2;
+        let mut q1 = SUB[m] * z * q2;
         let at = at + 2 * m + 2;
         out[at + m] = (q1 * c) as f32;
         out[at - m] = (q1 * s) as f32;
         for l in m + 2..bands {
             let k = tri(l, m);
-            let q = f64::from(A[k]) * (z * q1 - f64::from(B[k]) * r2 * q2);
+            let q = A[k] * (z * q1 - B[k] * r2 * q2);
             let at = l * l + l;
             out[at + m] = (q * c) as f32;
             out[at - m] = (q * s) as f32;
@@ -407,18 +427,18 @@ mod tests {
         for l in 2..MAX_BANDS {
             for m in 0..=l - 2 {
                 let (lf, mf) = (l as f64, m as f64);
-                let a = ((4.0 * lf * lf - 1.0) / (lf * lf - mf * mf)).sqrt() as f32;
+                let a = ((4.0 * lf * lf - 1.0) / (lf * lf - mf * mf)).sqrt();
                 let l1 = lf - 1.0;
-                let b = ((l1 * l1 - mf * mf) / (4.0 * l1 * l1 - 1.0)).sqrt() as f32;
+                let b = ((l1 * l1 - mf * mf) / (4.0 * l1 * l1 - 1.0)).sqrt();
                 assert_eq!((A[tri(l, m)], B[tri(l, m)]), (a, b), "l {l} m {m}");
             }
         }
         for m in 1..MAX_BANDS {
             let mf = m as f64;
-            assert_eq!(DIAG[m], -((2.0 * mf + 1.0) / (2.0 * mf)).sqrt() as f32);
+            assert_eq!(DIAG[m], -((2.0 * mf + 1.0) / (2.0 * mf)).sqrt());
         }
         for m in 0..MAX_BANDS {
-            assert_eq!(SUB[m], (2.0 * m as f64 + 3.0).sqrt() as f32);
+            assert_eq!(SUB[m], (2.0 * m as f64 + 3.0).sqrt());
         }
     }
 
@@ -476,10 +496,10 @@ mod tests {
         // The measured figures the docs and the README quote (deterministic: f64 inside,
         // a fixed direction set).
         assert!(
-            worst[10] <= 1.2e-6 && worst[29] <= 4.5e-6,
+            worst[10] <= 7e-8 && worst[28] <= 1.2e-7,
             "{:e} {:e}",
             worst[10],
-            worst[29]
+            worst[28]
         );
     }
 

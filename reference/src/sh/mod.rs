@@ -124,9 +124,58 @@ pub fn irradiance(coeffs: &[f64], n: [f64; 3]) -> f64 {
         .sum()
 }
 
+/// A product quadrature on the sphere exact for every product of two functions of
+/// `bands` bands: Gauss–Legendre in `z` with `bands` nodes (degree `2·bands − 1`) times
+/// `2·bands` equispaced azimuths (trigonometric degree `< 2·bands`). `(direction, weight)`.
+pub fn exact_grid(bands: usize) -> Vec<([f64; 3], f64)> {
+    let (zs, ws) = crate::quad::gauss_legendre(bands.max(1));
+    let nphi = 2 * bands.max(1);
+    let mut out = Vec::with_capacity(zs.len() * nphi);
+    for (z, w) in zs.iter().zip(&ws) {
+        let s = (1.0 - z * z).max(0.0).sqrt();
+        for j in 0..nphi {
+            let p = (j as f64 + 0.5) * 2.0 * PI / nphi as f64;
+            out.push(([s * p.cos(), s * p.sin(), *z], w * 2.0 * PI / nphi as f64));
+        }
+    }
+    out
+}
+
+/// The coefficients of `g(ω) = f(Rᵀω)` for `f` with coefficients `coeffs` (`bands²`) and the
+/// rotation `r` (rows, `r[i][j] = R_ij`), by projecting `g` onto the basis with
+/// [`exact_grid`]: no rotation formula, only evaluation at the rotated directions.
+pub fn rotate(coeffs: &[f64], r: [[f64; 3]; 3]) -> Vec<f64> {
+    let bands = (coeffs.len() as f64).sqrt().round() as usize;
+    let mut out = vec![0.0; bands * bands];
+    for (d, w) in exact_grid(bands) {
+        // Rᵀd: (Rᵀd)_j = Σ_i R_ij d_i.
+        let rd: [f64; 3] = std::array::from_fn(|j| (0..3).map(|i| r[i][j] * d[i]).sum());
+        let f: f64 = eval(rd, bands).iter().zip(coeffs).map(|(y, c)| y * c).sum();
+        for (o, y) in out.iter_mut().zip(eval(d, bands)) {
+            *o += w * f * y;
+        }
+    }
+    out
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn rotating_a_band_one_function_rotates_its_vector() {
+        // f(ω) = a·ω has coefficients ∝ (−a_y, a_z, −a_x) in band 1; g = f∘Rᵀ = (R a)·ω.
+        let k = (4.0 * PI / 3.0).sqrt();
+        let a = [0.3, -0.5, 0.8];
+        let c = [0.0, -k * a[1], k * a[2], -k * a[0]];
+        let (s, co) = (0.6f64, 0.8f64);
+        let r = [[co, 0.0, s], [0.0, 1.0, 0.0], [-s, 0.0, co]];
+        let ra: [f64; 3] = std::array::from_fn(|i| (0..3).map(|j| r[i][j] * a[j]).sum());
+        let want = [0.0, -k * ra[1], k * ra[2], -k * ra[0]];
+        for (g, w) in rotate(&c, r).iter().zip(want) {
+            assert!((g - w).abs() < 1e-13, "{g} vs {w}");
+        }
+    }
 
     /// Orthonormality by quadrature: Gauss–Kronrod in `z` (exact for these polynomials of
     /// degree ≤ 8) and the midpoint rule in `φ` (exact for trigonometric degree < 64).

@@ -11,7 +11,8 @@
 //!
 //! Those of `steradian_core::sh` (the HVL paper, eq. 7–8).
 
-use steradian_core::sh::{A, B, DIAG, SUB, Y00, check_shape, tri, unit_direction};
+use glam::DVec3;
+use steradian_core::sh::{A, B, DIAG, SUB, Y00_F64, check_shape, tri, unit_direction};
 use steradian_core::{Error, Vec3};
 use wide::f64x4;
 
@@ -27,33 +28,33 @@ pub fn eval_x4(dirs: [Vec3; 4], bands: usize, out: &mut [[f32; 4]]) -> Result<()
     fill(u, bands, &mut put);
     // The first coefficient is written in f32 like the scalar kernel's (`Y00 + 0·z`).
     if bands > 0 {
-        out[0] = u.map(|d| Y00 + 0.0 * d.z);
+        out[0] = u.map(|d| (Y00_F64 + 0.0 * d.z) as f32);
     }
     Ok(())
 }
 
 /// The scalar kernel's recurrence on four lanes; `put(k, v)` receives coefficient `k ≥ 1`.
 #[inline(always)]
-fn fill(u: [Vec3; 4], bands: usize, put: &mut impl FnMut(usize, f64x4)) {
+fn fill(u: [DVec3; 4], bands: usize, put: &mut impl FnMut(usize, f64x4)) {
     if bands < 2 {
         return;
     }
-    let lane = |f: fn(&Vec3) -> f32| f64x4::new(u.each_ref().map(|d| f64::from(f(d))));
+    let lane = |f: fn(&DVec3) -> f64| f64x4::new(u.each_ref().map(f));
     let (x, y, z) = (lane(|d| d.x), lane(|d| d.y), lane(|d| d.z));
     let r2 = x * x + y * y + z * z;
-    let y00 = f64::from(Y00);
+    let y00 = Y00_F64;
     let sp = f64x4::splat;
-    let (mut p2, mut p1) = (sp(y00), sp(f64::from(SUB[0])) * z * sp(y00));
+    let (mut p2, mut p1) = (sp(y00), sp(SUB[0]) * z * sp(y00));
     put(2, p1);
     for l in 2..bands {
         let k = tri(l, 0);
-        let p = sp(f64::from(A[k])) * (z * p1 - sp(f64::from(B[k])) * r2 * p2);
+        let p = sp(A[k]) * (z * p1 - sp(B[k]) * r2 * p2);
         put(l * l + l, p);
         (p2, p1) = (p1, p);
     }
     let (mut pmm, mut c, mut s) = (y00, sp(1.0), sp(0.0));
     for m in 1..bands {
-        pmm *= f64::from(DIAG[m]);
+        pmm *= DIAG[m];
         (c, s) = (x * c - y * s, x * s + y * c);
         let q = core::f64::consts::SQRT_2 * pmm;
         let mut q2 = sp(q);
@@ -63,13 +64,13 @@ fn fill(u: [Vec3; 4], bands: usize, put: &mut impl FnMut(usize, f64x4)) {
         if m + 1 == bands {
             break;
         }
-        let mut q1 = sp(f64::from(SUB[m])) * z * q2;
+        let mut q1 = sp(SUB[m]) * z * q2;
         let at = at + 2 * m + 2;
         put(at + m, q1 * c);
         put(at - m, q1 * s);
         for l in m + 2..bands {
             let k = tri(l, m);
-            let q = sp(f64::from(A[k])) * (z * q1 - sp(f64::from(B[k])) * r2 * q2);
+            let q = sp(A[k]) * (z * q1 - sp(B[k]) * r2 * q2);
             let at = l * l + l;
             put(at + m, q * c);
             put(at - m, q * s);
@@ -114,7 +115,7 @@ pub fn eval_slices(
         let u = dirs.map(unit_direction);
         if bands > 0 {
             for k in 0..live {
-                out[i + k] = Y00 + 0.0 * u[k].z;
+                out[i + k] = (Y00_F64 + 0.0 * u[k].z) as f32;
             }
         }
         let mut put = |c: usize, v: f64x4| {
