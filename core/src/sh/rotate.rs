@@ -682,6 +682,10 @@ mod tests {
                 worst.0 <= bound && worst.1 <= bound,
                 "{bands}: {worst:?} > {bound}"
             );
+            if bands == 30 {
+                // The figures the module docs and the README quote.
+                assert!(worst.0 <= 1.3e-7 && worst.1 <= 5e-8, "{worst:?}");
+            }
         }
     }
 
@@ -965,6 +969,6 @@ mod tests {
             .map(|(x, y)| (x - y).abs())
             .fold(0.0f32, f32::max);
         println!("100 bands: operator vs zxzxz {e:.2e}");
-        assert!(e < 1e-4);
+        assert!(e < 1.3e-6, "{e}");
     }
 }
