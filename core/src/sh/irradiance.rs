@@ -28,8 +28,7 @@
 //! band-limited radiance, to `1e-6` of `Σ|A_l|·|L_l^m|`-weighted sums (the evaluation's
 //! error).
 
-use crate::math;
-use crate::sh::eval_into;
+use crate::sh::{bands_of, eval_into};
 use crate::{Error, Vec3};
 
 /// `A_l`, the clamped-cosine convolution factor of band `l` (module docs), in `f64`.
@@ -57,15 +56,7 @@ pub fn clamped_cosine(l: usize) -> f64 {
 ///
 /// Errors: `radiance.len()` not a square of at most `MAX_BANDS²`, or `scratch` shorter.
 pub fn irradiance(radiance: &[f32], normal: Vec3, scratch: &mut [f32]) -> Result<f32, Error> {
-    let bands = math_isqrt(radiance.len());
-    if bands * bands != radiance.len() {
-        return Err(Error::OutOfRange {
-            what: "SH coefficient count (must be a square)",
-            value: radiance.len() as f32,
-            min: 0.0,
-            max: f32::INFINITY,
-        });
-    }
+    let bands = bands_of(radiance.len())?;
     eval_into(normal, bands, scratch)?;
     let mut e = 0.0f64;
     for l in 0..bands {
@@ -86,17 +77,6 @@ pub fn irradiance(radiance: &[f32], normal: Vec3, scratch: &mut [f32]) -> Result
 #[inline]
 pub fn lambert_radiance(albedo: f32, irradiance: f32) -> f32 {
     albedo * irradiance * core::f32::consts::FRAC_1_PI
-}
-
-fn math_isqrt(c: usize) -> usize {
-    let mut n = math::sqrt64(c as f64) as usize;
-    while n * n > c {
-        n -= 1;
-    }
-    while (n + 1) * (n + 1) <= c {
-        n += 1;
-    }
-    n
 }
 
 #[cfg(all(test, feature = "alloc"))]

@@ -86,8 +86,11 @@
 //!   Equation numbers in this folder are the arXiv version's.
 
 pub mod cap;
+pub mod convolve;
 pub mod irradiance;
+pub mod light;
 pub mod rotate;
+pub mod window;
 
 use crate::math;
 use crate::{Error, Vec3};
@@ -344,6 +347,28 @@ pub fn check_shape(bands: usize, len: usize) -> Result<(), Error> {
         });
     }
     Ok(())
+}
+
+/// The band count `n` of a coefficient vector of length `n²`; an error for a length that is
+/// not a square.
+pub fn bands_of(len: usize) -> Result<usize, Error> {
+    let mut n = math::sqrt64(len as f64) as usize;
+    while n * n > len {
+        n -= 1;
+    }
+    while (n + 1) * (n + 1) <= len {
+        n += 1;
+    }
+    if n * n != len {
+        return Err(Error::OutOfRange {
+            what: "SH coefficient count (must be a square n²)",
+            value: len as f32,
+            min: 0.0,
+            max: (crate::sh::MAX_BANDS * crate::sh::MAX_BANDS) as f32,
+        });
+    }
+    check_shape(n, len)?;
+    Ok(n)
 }
 
 /// All `C = n²` real SH of the first `n` bands at `dir` (module docs), as an array: the

@@ -72,7 +72,7 @@
 //!   decomposition with the fixed 90° blocks).
 
 use crate::math;
-use crate::sh::check_shape;
+use crate::sh::{bands_of, check_shape};
 use crate::{Error, Vec3};
 use glam::{DMat3, DVec3};
 
@@ -571,28 +571,6 @@ impl Rotator {
         }
         rotate_zxzxz(&self.x90, rot, n, input, out)
     }
-}
-
-/// The band count `n` of a coefficient vector of length `n²`; an error for a length that is
-/// not a square.
-pub fn bands_of(len: usize) -> Result<usize, Error> {
-    let mut n = math::sqrt64(len as f64) as usize;
-    while n * n > len {
-        n -= 1;
-    }
-    while (n + 1) * (n + 1) <= len {
-        n += 1;
-    }
-    if n * n != len {
-        return Err(Error::OutOfRange {
-            what: "SH coefficient count (must be a square n²)",
-            value: len as f32,
-            min: 0.0,
-            max: (crate::sh::MAX_BANDS * crate::sh::MAX_BANDS) as f32,
-        });
-    }
-    check_shape(n, len)?;
-    Ok(n)
 }
 
 #[cfg(all(test, feature = "alloc"))]
