@@ -121,7 +121,7 @@ fn main() -> ExitCode {
                             (true, false) => "DIFFERS from a fresh generation",
                         };
                         ok &= o.matches;
-                        println!("{:<20} {:>8} bytes  {what}", o.file, o.bytes);
+                        println!("{:<30} {:>8} bytes  {what}", o.file, o.bytes);
                     }
                     if ok {
                         ExitCode::SUCCESS

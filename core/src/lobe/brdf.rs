@@ -16,6 +16,7 @@
 //! | [`Phong`] | `k_d/π + k_s·(e+2)/(2π)·max(r·wᵢ, 0)^e`, `r = (−wₒx, −wₒy, wₒz)` | Lewis 1994 ("modified Phong"); the same normalisation as [`crate::lobe::Phong::modified`] |
 //! | [`BlinnPhong`] | `k_d/π + k_s·(e+8)/(8π)·(ĥ_z)^e` | Blinn 1977; normalisation of Akenine-Möller, Haines & Hoffman, *Real-Time Rendering* 3rd ed., eq. 7.49 |
 //! | [`Ward`] | `ρ_d/π + ρ_s·exp(−((h_x/α_x)² + (h_y/α_y)²)/h_z²)/(4π·α_x·α_y·√(cos θᵢ cos θₒ))` | Ward 1992, eq. 5a (isotropic eq. 4a: `α_x = α_y`) |
+//! | [`crate::lobe::Lafortune`] | `Σ_k ρ_k·max(C_x wᵢx wₒx + C_y wᵢy wₒy + C_z wᵢz wₒz, 0)^(e_k)` | Lafortune, Foo, Torrance, Greenberg 1997 |
 //! | [`Ggx`] | `k_d/π + D(ĥ)·G₂·F/(4 cos θᵢ cos θₒ)` | Cook & Torrance 1982 microfacet form; GGX `D` of Walter et al. 2007 eq. 33; separable Smith `G₂ = G₁(wᵢ)G₁(wₒ)` with Walter eq. 34; Schlick 1994 Fresnel |
 //!
 //! GGX details: `D = α²/(π((α²−1)ĥ_z² + 1)²)`, written as `α²|h|⁴/(π(h_x² + h_y² + α²h_z²)²)`
@@ -408,6 +409,44 @@ impl Brdf for Ggx {
     }
     fn name(&self) -> &'static str {
         "GGX"
+    }
+}
+
+impl<const N: usize> Brdf for crate::lobe::Lafortune<N> {
+    /// `Σ_k ρ_k·max(C_x·wᵢx·wₒx + C_y·wᵢy·wₒy + C_z·wᵢz·wₒz, 0)^(e_k)·cos θᵢ` (Lafortune
+    /// et al. 1997, eq. 28 of the cosine-lobe paper); a lobe with `C = (0, 0, 1)` and
+    /// `e = 0` is a constant (diffuse) term.
+    #[inline]
+    fn eval(&self, wi: Vec3, wo: Vec3) -> f32 {
+        if let Some(g) = guard(wi, wo) {
+            return g;
+        }
+        let mut rho = 0.0;
+        for l in &self.lobes {
+            let d = l.c.x * wi.x * wo.x + l.c.y * wi.y * wo.y + l.c.z * wi.z * wo.z;
+            if d > 0.0 {
+                rho += l.rho
+                    * if l.exponent == 0.0 {
+                        1.0
+                    } else {
+                        math::powf(d, l.exponent)
+                    };
+            }
+        }
+        rho * wi.z
+    }
+    fn is_isotropic(&self) -> bool {
+        self.lobes.iter().all(|l| l.c.x == l.c.y)
+    }
+    fn feature_angle(&self) -> f32 {
+        self.lobes
+            .iter()
+            .filter(|l| l.exponent > 0.0)
+            .map(|l| 1.0 / math::sqrtf(l.exponent + 1.0))
+            .fold(1.0, f32::min)
+    }
+    fn name(&self) -> &'static str {
+        "Lafortune"
     }
 }
 

@@ -279,6 +279,11 @@ impl<const N: usize> Lafortune<N> {
         Ok(Lafortune { lobes })
     }
 
+    /// The validated lobes.
+    pub fn lobe_params(&self) -> &[LafortuneLobe; N] {
+        &self.lobes
+    }
+
     /// The cosine lobes for view `wo` (world frame) in shading frame `frame` (eq. 30):
     /// axis `M·wo/|M·wo|`, scale `ρ·|M·wo|^e`. A lobe with `M·wo = 0` gets scale 0 (its
     /// value is `0^e`) and the normal as axis (`1` when `e = 0`, as `0^0 = 1`).

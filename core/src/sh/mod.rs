@@ -85,6 +85,7 @@
 //!   *Computer Graphics Forum* 41(6), 2022. DOI: 10.1111/cgf.14564 (arXiv: 2201.01487).
 //!   Equation numbers in this folder are the arXiv version's.
 
+pub mod brdf;
 pub mod cap;
 pub mod convolve;
 pub mod irradiance;

@@ -1,16 +1,17 @@
 //! Table generators. Each built-in table of `steradian-core` is produced here in f64 from
-//! its exact definition, encoded with `steradian_core::table`, and committed under
-//! `core/src/lobe/tables/`. `steradian tables` rewrites them; `steradian tables --check`
+//! its exact definition, encoded with `steradian_core::table`, and committed beside the
+//! module that reads it (`core/src/lobe/tables/`, `core/src/sh/tables/`). `steradian tables` rewrites them; `steradian tables --check`
 //! regenerates in memory and fails if a committed file differs.
 
+pub mod brdf_sh;
 pub mod cap_exponent;
 pub mod lobe_product;
 
 use std::path::{Path, PathBuf};
 
-/// A built-in table: its file name under `core/src/lobe/tables/` and its generator.
+/// A built-in table: its path under `core/src/` and its generator.
 pub struct TableDef {
-    /// File name, e.g. `cap_exponent.bin`.
+    /// Path under `core/src/`, e.g. `lobe/tables/cap_exponent.bin`.
     pub file: &'static str,
     /// What the table holds.
     pub about: &'static str,
@@ -21,20 +22,40 @@ pub struct TableDef {
 /// Every built-in table.
 pub const TABLES: &[TableDef] = &[
     TableDef {
-        file: "cap_exponent.bin",
+        file: "lobe/tables/cap_exponent.bin",
         about: "h(α) = e*(α)·α², L2-optimal cap exponent, uniform over [0, π/2]",
         generate: cap_exponent::generate,
     },
     TableDef {
-        file: "lobe_product.bin",
+        file: "lobe/tables/lobe_product.bin",
         about: "g = ln I − ln B, the lobe-product integral's correction to its closed-form baseline",
         generate: lobe_product::generate,
     },
+    TableDef {
+        file: "sh/tables/brdf_lambert.bin",
+        about: "SH of Lambert (albedo 1) with and without the cosine, per view",
+        generate: brdf_sh::generate_lambert,
+    },
+    TableDef {
+        file: "sh/tables/brdf_phong30.bin",
+        about: "SH of modified Phong (specular 1, exponent 30), per view",
+        generate: brdf_sh::generate_phong,
+    },
+    TableDef {
+        file: "sh/tables/brdf_lafortune.bin",
+        about: "SH of a two-lobe Lafortune BRDF, per view",
+        generate: brdf_sh::generate_lafortune,
+    },
+    TableDef {
+        file: "sh/tables/brdf_ggx.bin",
+        about: "SH of GGX (F0 0.04, alpha 0.3) with Schlick Fresnel, per view",
+        generate: brdf_sh::generate_ggx,
+    },
 ];
 
-/// `core/src/lobe/tables` of this source tree.
+/// `core/src` of this source tree (the table paths are relative to it).
 pub fn default_dir() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("../core/src/lobe/tables")
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../core/src")
 }
 
 /// Outcome of writing or checking one table.
@@ -62,6 +83,9 @@ pub fn run(dir: &Path, check_only: bool) -> std::io::Result<Vec<Outcome>> {
                 Err(e) => return Err(e),
             }
         } else {
+            if let Some(parent) = path.parent() {
+                std::fs::create_dir_all(parent)?;
+            }
             std::fs::write(&path, &fresh)?;
             true
         };

@@ -97,6 +97,24 @@ impl AsModel for core_brdf::Ggx {
     }
 }
 
+impl AsModel for steradian_core::lobe::Lafortune<2> {
+    fn model(&self) -> brdf::Model {
+        let l = self.lobe_params();
+        let p = |k: usize| {
+            [
+                l[k].c.x as f64,
+                l[k].c.y as f64,
+                l[k].c.z as f64,
+                l[k].exponent as f64,
+                l[k].rho as f64,
+            ]
+        };
+        brdf::Model::Lafortune {
+            lobes: [p(0), p(1)],
+        }
+    }
+}
+
 /// `ρ cos θᵢ` of a core model through its `Brdf` impl, for directions given in `f64`.
 pub fn core_eval<B: core_brdf::Brdf + ?Sized>(b: &B, wi: [f64; 3], wo: [f64; 3]) -> f32 {
     let v = |d: [f64; 3]| steradian_core::Vec3::new(d[0] as f32, d[1] as f32, d[2] as f32);

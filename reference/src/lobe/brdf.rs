@@ -49,6 +49,12 @@ pub enum Model {
         /// Roughness along the bitangent.
         ay: f64,
     },
+    /// Lafortune et al. 1997: `Σ ρ·max(C_x wᵢx wₒx + C_y wᵢy wₒy + C_z wᵢz wₒz, 0)^e`, two
+    /// lobes `[C_x, C_y, C_z, e, ρ]`.
+    Lafortune {
+        /// The lobes.
+        lobes: [[f64; 5]; 2],
+    },
     /// Cook–Torrance with GGX, separable Smith and Schlick.
     Ggx {
         /// Diffuse weight.
@@ -97,6 +103,13 @@ impl Model {
                 let k = tan2 * (c2 / (ax * ax) + s2 / (ay * ay));
                 rd / PI + rs * libm::exp(-k) / (4.0 * PI * ax * ay * (wi[2] * wo[2]).sqrt())
             }
+            Model::Lafortune { lobes } => lobes
+                .iter()
+                .map(|&[cx, cy, cz, e, rho]| {
+                    let d = cx * wi[0] * wo[0] + cy * wi[1] * wo[1] + cz * wi[2] * wo[2];
+                    if d > 0.0 { rho * libm::pow(d, e) } else { 0.0 }
+                })
+                .sum(),
             Model::Ggx { kd, f0, alpha } => {
                 let a2 = alpha * alpha;
                 let ch = h[2];
@@ -120,6 +133,11 @@ impl Model {
             Model::Phong { e, .. } => (1.0 / (e + 1.0).sqrt()).min(1.0),
             Model::BlinnPhong { e, .. } => (2.0 / (e + 1.0).sqrt()).min(1.0),
             Model::Ward { ax, ay, .. } => ax.min(ay),
+            Model::Lafortune { lobes } => lobes
+                .iter()
+                .filter(|l| l[3] > 0.0)
+                .map(|l| 1.0 / (l[3] + 1.0).sqrt())
+                .fold(1.0, f64::min),
             Model::Ggx { alpha, .. } => alpha,
         }
     }
