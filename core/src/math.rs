@@ -50,6 +50,7 @@ shim! {
     sinf(f32) => sin, sinf;
     cosf(f32) => cos, cosf; // used by `brdf_sat` (feature `alloc`) only
     asinf(f32) => asin, asinf;
+    acosf(f32) => acos, acosf;
     atan2f(f32, x2) => atan2, atan2f;
     ceilf(f32) => ceil, ceilf;
     floorf(f32) => floor, floorf;

@@ -88,6 +88,7 @@
 pub mod brdf;
 pub mod cap;
 pub mod convolve;
+pub mod hvl;
 pub mod irradiance;
 pub mod light;
 pub mod rotate;

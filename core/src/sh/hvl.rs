@@ -1,0 +1,606 @@
+//! Harmonics Virtual Lights (HVL paper section 5, eq. 19–26): secondary spherical lights
+//! whose emission is an SH-projected BRDF, shading a point with two dot products each.
+//!
+//! ## One HVL's contribution (eq. 19–22)
+//!
+//! An HVL `j` at `y` (radius `r`, surface normal `n_j`, power `Φ` received from a primary
+//! light in the direction `ω_l`) seen from the shading point `x` (normal `n_x`) in the unit
+//! direction `ω_j = (y − x)/d` subtends the cap of half-angle `a = asin(r/d)`. With the
+//! receiver's BRDF coefficients `F` (with the cosine, [`crate::sh::brdf`]) in its view frame:
+//!
+//! ```text
+//!   L_o = L_j·(L·F),                 L = ∫_cap Y dω            (eq. 19, eq. 15: sh::cap)
+//!   L_j = Φ·(F′·Y(−ω_j))·G_j                                  (eq. 20)
+//!   G_j = max(0, n_j·(−ω_j))·H(n_x, ω_j)/(π r²)               (eq. 21)
+//! ```
+//!
+//! `F′·Y(−ω_j)` is the HVL material's BRDF from `ω_l` toward `x`, reconstructed from the
+//! `F′` table at `θ_l` in the HVL's own view frame (`x` toward `ω_l`; reciprocity). Units:
+//! the disk `πr²` receiving `Φ` reflects the radiance `f·Φ/(πr²)`, seen over its projected
+//! area, i.e. `f·Φ·cos/(πr²)` spread over a cap of the same solid angle.
+//!
+//! **`H`, the part of the cap above the receiver's horizon (eq. 22, derived).** With `θ` the
+//! angle between `n_x` and the cap's axis, the cap lies wholly above the horizon for
+//! `θ ≤ π/2 − a` and wholly below for `θ ≥ π/2 + a`, and it is cut in half at `θ = π/2`;
+//! the smoothstep `S(t) = 3t² − 2t³` of `t = (ā − clamp(θ, π/2 − a, ā))/(2a)`,
+//! `ā = π/2 + a`, has exactly these three values (1, 0, ½). The extracted text reads the
+//! lower clamp as `a − π/2`, which would leave `t > 1` (and `S(t) < 1`, falling) for caps
+//! well above the horizon: only `π/2 − a` fits the geometry. [`Horizon::Exact`] is the
+//! exact fraction instead, from the area of the intersection of two caps
+//! (Tovchigrechko–Vakser) with one of them the hemisphere:
+//! `A = 2·(π(1 − cos a) − acos(cos θ/sin a) + cos a·acos(cot θ·cot a))`, divided by the
+//! cap's `2π(1 − cos a)`, in `f64` (tested against quadrature; the two are compared in the
+//! tests: at most 0.09 apart for caps up to 1.5 rad).
+//!
+//! **Saturation, never an error on the hot path.** A point inside an HVL (`d ≤ r`) sees it
+//! as the hemisphere-sized cap `a = π/2` around `ω_j`; a point at the HVL's centre or
+//! infinitely far, an HVL facing away (`n_j·ω_j ≥ 0`) or a cap wholly below the horizon
+//! contributes 0; a NaN point gives NaN.
+//!
+//! ## The radius heuristics (eq. 23–26)
+//!
+//! - [`radius_from_neighbours`] (`r1`, eq. 23): `k·Σ w_n·|p − p_n| / Σ w_n` over the
+//!   neighbours in the reflective shadow map, `w_n = 1/(|d − d_n| + ε)` with `d` the depths
+//!   in light space.
+//! - [`radius_from_fov`] (`r2`, eq. 24–25): `√M × √M` HVLs in a square map of field of view
+//!   `λ` are `λ/√M` apart in angle, diagonal neighbours `γ = √2·λ/√M`; the right triangle
+//!   at the HVL gives the distance `d·tan γ`, so `r2 = k·d·tan γ`. [`radius_from_fov_taylor`]
+//!   (eq. 26) uses `tan γ ≈ γ + γ³/3`, within `0.01` for `γ ≤ 0.575` (tested), i.e. for
+//!   `λ/√M ≤ 0.41` — with the map's *half*-angle `λ/2`, the paper's `λ/√M ≲ 0.2` (a spot of
+//!   half-angle 45° needs `M ≥ 16`, of 90° `M ≥ 64`; tested).
+//!
+//! **Accuracy** against the `f64` quadrature of the exact integrand — constant emission
+//! `Φ·f_j·max(0, n_j·(−ω_j))/(πr²)` over the cap, times the receiver's BRDF and clamped
+//! cosine — per band limit (relative L2 over four placements: overhead, toward the glossy
+//! direction, off to the side, near the receiver's horizon; a Lambertian HVL with
+//! [`lambert_emission`]; tests below):
+//!
+//! | receiver | 1 | 2 | 3 | 5 | 7 | 9 | 14 bands |
+//! |---|---|---|---|---|---|---|---|
+//! | Lambert ([`crate::sh::brdf::lambert`]) | 0.70 | 0.21 | 0.021 | 0.015 | | | |
+//! | Phong 30 ([`crate::sh::brdf::phong`]) | | | 0.83 | 0.59 | 0.35 | 0.17 | 0.013 |
+//!
+//! The smoothstep `H` changes these by less than `1e-3`. Reconstructing a Lambertian HVL's
+//! emission from the 5-band `F′` table instead of [`lambert_emission`] costs 12 % (the ringing
+//! of the hemisphere's indicator). The report's HVL section (the paper's Table 1) measures
+//! whole sets of HVLs.
+//!
+//! # References
+//!
+//! - The HVL paper (see [`crate::sh`]), section 5.
+//! - A. Tovchigrechko, I. A. Vakser, "How common is the funnel-like energy landscape in
+//!   protein-protein interactions?", *Protein Science* 10, 2001 (the area of the
+//!   intersection of two spherical caps). DOI: 10.1110/ps.8701.
+
+use crate::frame::Frame;
+use crate::math;
+use crate::sh::{brdf::view_frame, cap, eval_into};
+use crate::{Error, Vec3};
+
+/// How [`contribution`] weighs the part of the HVL below the receiver's horizon.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Horizon {
+    /// The paper's smoothstep (eq. 22, module docs).
+    Smoothstep,
+    /// The exact fraction of the cap above the horizon.
+    Exact,
+}
+
+/// A Harmonics Virtual Light (module docs).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Hvl {
+    position: Vec3,
+    frame: Frame,
+    theta_l: f32,
+    radius: f32,
+    power: f32,
+}
+
+impl Hvl {
+    /// The HVL at `position` on a surface of normal `normal`, lit from the direction
+    /// `to_light` (toward the primary light), of radius `radius > 0` and power `power`
+    /// (W, per channel, `≥ 0`).
+    ///
+    /// Errors: non-finite input, a zero normal or light direction, a radius `≤ 0`, a negative
+    /// power.
+    pub fn new(
+        position: Vec3,
+        normal: Vec3,
+        to_light: Vec3,
+        radius: f32,
+        power: f32,
+    ) -> Result<Self, Error> {
+        if !position.is_finite() || !radius.is_finite() || !power.is_finite() {
+            return Err(Error::NonFinite { what: "HVL" });
+        }
+        if radius <= 0.0 {
+            return Err(Error::OutOfRange {
+                what: "HVL radius",
+                value: radius,
+                min: f32::MIN_POSITIVE,
+                max: f32::MAX,
+            });
+        }
+        if power < 0.0 {
+            return Err(Error::OutOfRange {
+                what: "HVL power",
+                value: power,
+                min: 0.0,
+                max: f32::MAX,
+            });
+        }
+        let frame = view_frame(normal, to_light)?;
+        let l = crate::frame::normalize_or_zero(to_light);
+        if l == Vec3::ZERO {
+            return Err(Error::ZeroVector {
+                what: "HVL light direction",
+            });
+        }
+        let theta_l = math::acosf(l.dot(frame.normal()).clamp(-1.0, 1.0));
+        Ok(Hvl {
+            position,
+            frame,
+            theta_l,
+            radius,
+            power,
+        })
+    }
+
+    /// The centre.
+    pub fn position(&self) -> Vec3 {
+        self.position
+    }
+    /// The radius.
+    pub fn radius(&self) -> f32 {
+        self.radius
+    }
+    /// The angle `θ_l` between the normal and the light: where to look up the emission's
+    /// `F′` table.
+    pub fn theta_l(&self) -> f32 {
+        self.theta_l
+    }
+    /// The view frame of the HVL's surface toward its light (the emission's frame).
+    pub fn frame(&self) -> &Frame {
+        &self.frame
+    }
+}
+
+/// `H` of eq. 22 (module docs): the smoothstep of the part of a cap of half-angle `a`
+/// whose axis makes the cosine `cos_theta` with the normal that lies above the horizon.
+pub fn horizon_smoothstep(cos_theta: f32, a: f32) -> f32 {
+    // t = (ā − clamp(θ, π/2 − a, ā))/(2a) with π/2 − θ = asin(cos θ): no cancellation
+    // against π/2 for small caps.
+    let c = cos_theta.clamp(-1.0, 1.0);
+    if a.is_nan() {
+        return f32::NAN;
+    }
+    if a <= 0.0 {
+        return if c > 0.0 { 1.0 } else { 0.0 };
+    }
+    let t = ((a + math::asinf(c)) / (2.0 * a)).clamp(0.0, 1.0);
+    t * t * (3.0 - 2.0 * t)
+}
+
+/// The exact fraction of a cap of half-angle `a ∈ [0, π/2]` above the horizon, its axis at
+/// the cosine `cos_theta` from the normal (module docs; `f64` inside).
+pub fn horizon_exact(cos_theta: f32, a: f32) -> f32 {
+    let (c, a) = (f64::from(cos_theta.clamp(-1.0, 1.0)), f64::from(a));
+    let s = math::sqrt64((1.0 - c * c).max(0.0));
+    let (sa, ca) = (math::sin64(a), math::cos64(a));
+    // Wholly above (θ ≤ π/2 − a ⇔ cos θ ≥ sin a) or below.
+    if c >= sa {
+        return 1.0;
+    }
+    if -c >= sa {
+        return 0.0;
+    }
+    let u = (c / sa).clamp(-1.0, 1.0);
+    let w = if s > 0.0 {
+        (c * ca / (s * sa)).clamp(-1.0, 1.0)
+    } else {
+        0.0
+    };
+    let one_minus_cos = 2.0 * math::sin64(0.5 * a) * math::sin64(0.5 * a);
+    let pi = core::f64::consts::PI;
+    // The area of the cap ∩ the upper hemisphere (module docs), over the cap's area.
+    let above = 2.0 * (pi * one_minus_cos - acos64(u) + ca * acos64(w));
+    let cap = 2.0 * pi * one_minus_cos;
+    (above / cap).clamp(0.0, 1.0) as f32
+}
+
+fn acos64(x: f64) -> f64 {
+    math::atan2_64(math::sqrt64((1.0 - x * x).max(0.0)), x)
+}
+
+/// The receiver of [`contribution`]: the shading point, its view frame
+/// ([`crate::sh::brdf::view_frame`] of its normal and view) and its BRDF's `F` coefficients
+/// in that frame (`n²`, e.g. from [`crate::sh::brdf::BrdfSh::lookup_into`]).
+#[derive(Clone, Copy, Debug)]
+pub struct Receiver<'a> {
+    /// The shading point.
+    pub point: Vec3,
+    /// Its view frame.
+    pub frame: Frame,
+    /// `F` in the view frame.
+    pub coeffs: &'a [f32],
+}
+
+/// The radiance one HVL sends toward the receiver's view (eq. 19–22, module docs).
+/// `emission` holds the HVL material's `F′` at the HVL's `θ_l` in its frame (any band
+/// count, 1 for an isotropic emitter); `scratch` at least `max(n², n_e²)` values.
+///
+/// Errors: coefficient counts that are not squares, a short `scratch`.
+pub fn contribution(
+    hvl: &Hvl,
+    emission: &[f32],
+    rx: &Receiver<'_>,
+    horizon: Horizon,
+    scratch: &mut [f32],
+) -> Result<f32, Error> {
+    let n = crate::sh::bands_of(rx.coeffs.len())?;
+    let ne = crate::sh::bands_of(emission.len())?;
+    crate::sh::check_shape(n.max(ne), scratch.len())?;
+    let v = hvl.position - rx.point;
+    let d = math::sqrtf(v.dot(v));
+    if d.is_nan() {
+        return Ok(f32::NAN);
+    }
+    if d <= 0.0 || !d.is_finite() {
+        return Ok(0.0);
+    }
+    let w = v / d;
+    let cos_j = -w.dot(hvl.frame.normal());
+    if cos_j <= 0.0 {
+        return Ok(0.0);
+    }
+    let sin_a = (hvl.radius / d).min(1.0);
+    let a = math::asinf(sin_a);
+    let cos_x = w.dot(rx.frame.normal());
+    let h = match horizon {
+        Horizon::Smoothstep => horizon_smoothstep(cos_x, a),
+        Horizon::Exact => horizon_exact(cos_x, a),
+    };
+    if h == 0.0 {
+        return Ok(0.0);
+    }
+    // Emission toward x: F′·Y(−ω_j) in the HVL's frame.
+    eval_into(hvl.frame.to_local(-w), ne, scratch)?;
+    let e: f32 = emission
+        .iter()
+        .zip(scratch.iter())
+        .map(|(a, b)| a * b)
+        .sum();
+    // The cap in the receiver's frame, dotted with F.
+    cap::coefficients_into(rx.frame.to_local(w), a, n, scratch)?;
+    let s: f32 = rx
+        .coeffs
+        .iter()
+        .zip(scratch.iter())
+        .map(|(a, b)| a * b)
+        .sum();
+    let g = cos_j * h / (core::f32::consts::PI * hvl.radius * hvl.radius);
+    Ok(hvl.power * e * g * s)
+}
+
+/// The emission coefficients of a Lambertian HVL of albedo `albedo`: the constant
+/// `albedo/π` (one band, `albedo/(π·Y_0^0)`). Exact, not an approximation of the
+/// hemisphere's indicator: [`contribution`] already gives 0 on the HVL's back side, so the
+/// emission is only ever evaluated on its front, where a Lambertian surface's BRDF is that
+/// constant (the `F′` table's 5-band reconstruction of `[cos > 0]/π` rings by 10–20 % near
+/// the HVL's horizon; measured in the tests).
+pub fn lambert_emission(albedo: f32) -> [f32; 1] {
+    [albedo / (core::f32::consts::PI * crate::sh::Y00)]
+}
+
+/// `r1` of eq. 23: `k·Σ w_n·|p − p_n| / Σ w_n`, `w_n = 1/(|d − d_n| + ε)`, over the
+/// neighbours `(p_n, d_n)` (positions and light-space depths). No neighbour gives 0.
+pub fn radius_from_neighbours(
+    p: Vec3,
+    depth: f32,
+    neighbours: &[(Vec3, f32)],
+    k: f32,
+    eps: f32,
+) -> f32 {
+    let (mut num, mut den) = (0.0f32, 0.0f32);
+    for &(q, dq) in neighbours {
+        let w = 1.0 / ((depth - dq).abs() + eps);
+        num += w * (p - q).length();
+        den += w;
+    }
+    if den > 0.0 { k * num / den } else { 0.0 }
+}
+
+/// `γ = √2·λ/√M` of eq. 24: the angle between diagonal neighbours among `M` HVLs in a
+/// square map of field of view `fov` (radians, the full angle).
+pub fn diagonal_angle(fov: f32, count: u32) -> f32 {
+    core::f32::consts::SQRT_2 * fov / math::sqrtf(count.max(1) as f32)
+}
+
+/// `r2 = k·d·tan γ` of eq. 25 (module docs).
+pub fn radius_from_fov(depth: f32, fov: f32, count: u32, k: f32) -> f32 {
+    let g = diagonal_angle(fov, count);
+    k * depth * math::sinf(g) / math::cosf(g)
+}
+
+/// `r2 ≈ k·d·(γ + γ³/3)` of eq. 26, within `0.01·k·d` of [`radius_from_fov`] for
+/// `γ ≤ 0.575`.
+pub fn radius_from_fov_taylor(depth: f32, fov: f32, count: u32, k: f32) -> f32 {
+    let g = diagonal_angle(fov, count);
+    k * depth * (g + g * g * g / 3.0)
+}
+
+#[cfg(all(test, feature = "alloc"))]
+mod tests {
+    use super::*;
+    use crate::sh::brdf::{self, Part};
+    use alloc::vec;
+    use alloc::vec::Vec;
+    extern crate std;
+    use std::println;
+    use steradian_reference::lobe::brdf::Model;
+
+    #[test]
+    fn the_smoothstep_has_the_three_exact_values_and_is_near_the_exact_fraction() {
+        let mut worst = 0.0f32;
+        for a in [1e-4f32, 0.05, 0.3, 0.8, 1.5] {
+            let half_pi = core::f32::consts::FRAC_PI_2;
+            assert_eq!(horizon_smoothstep(math::cosf(half_pi - a - 1e-3), a), 1.0);
+            assert_eq!(
+                horizon_smoothstep(
+                    math::cosf((half_pi + a + 1e-3).min(core::f32::consts::PI)),
+                    a
+                ),
+                0.0
+            );
+            assert!((horizon_smoothstep(0.0, a) - 0.5).abs() < 1e-5);
+            assert!((horizon_exact(0.0, a) - 0.5).abs() < 1e-5);
+            for i in 0..=200 {
+                let th = half_pi - a + 2.0 * a * i as f32 / 200.0;
+                let c = math::cosf(th);
+                worst = worst.max((horizon_smoothstep(c, a) - horizon_exact(c, a)).abs());
+            }
+        }
+        println!("smoothstep vs exact: {worst}");
+        assert!(worst < 0.09, "{worst}");
+    }
+
+    #[test]
+    fn the_exact_fraction_matches_quadrature() {
+        // Fraction of the cap above z = 0 by sampling the cap on a polar grid.
+        for (a, th) in [(0.3f64, 1.4f64), (0.8, 1.0), (0.05, 1.56), (1.2, 2.0)] {
+            let axis = [th.sin(), 0.0, th.cos()];
+            let (t1, t2) = steradian_reference::perpendiculars(axis);
+            let (mut above, mut all) = (0.0, 0.0);
+            let (gx, gw) = steradian_reference::quad::gauss_legendre(64);
+            for (x, w) in gx.iter().zip(&gw) {
+                let t = 0.5 * a * (1.0 + x);
+                let (s, c) = t.sin_cos();
+                for j in 0..512 {
+                    let p = (j as f64 + 0.5) * core::f64::consts::TAU / 512.0;
+                    let d: Vec<f64> = (0..3)
+                        .map(|i| c * axis[i] + s * (p.cos() * t1[i] + p.sin() * t2[i]))
+                        .collect();
+                    let wt = w * s;
+                    all += wt;
+                    if d[2] > 0.0 {
+                        above += wt;
+                    }
+                }
+            }
+            let want = above / all;
+            let got = horizon_exact(th.cos() as f32, a as f32);
+            assert!(
+                (f64::from(got) - want).abs() < 2e-3,
+                "a {a} θ {th}: {got} vs {want}"
+            );
+        }
+    }
+
+    #[test]
+    fn the_taylor_radius_holds_in_the_papers_validity_domain() {
+        // |tan γ − (γ + γ³/3)| ≤ 0.01 exactly up to γ ≈ 0.58.
+        for i in 0..=575 {
+            let g = i as f64 / 1000.0;
+            assert!((g.tan() - (g + g * g * g / 3.0)).abs() <= 0.01, "{g}");
+        }
+        assert!((0.60f64.tan() - (0.6 + 0.216 / 3.0)) > 0.01);
+        // Spots of half-angle 45° (fov 90°) need M ≥ 16, of 90° (fov 180°) M ≥ 64.
+        let pi = core::f32::consts::PI;
+        for (fov, m) in [(0.5 * pi, 16u32), (pi, 64)] {
+            let (a, b) = (
+                radius_from_fov(1.0, fov, m, 1.0),
+                radius_from_fov_taylor(1.0, fov, m, 1.0),
+            );
+            assert!(
+                diagonal_angle(fov, m) <= 0.58 && (a - b).abs() <= 0.01,
+                "{fov} {m}: {a} {b}"
+            );
+            let small = (m as f32 * 0.5) as u32;
+            assert!(diagonal_angle(fov, small) > 0.58);
+        }
+        assert!(
+            (radius_from_fov(2.0, 0.1, 100, 1.5) - 1.5 * 2.0 * (0.1f32 * 2f32.sqrt() / 10.0).tan())
+                .abs()
+                < 1e-6
+        );
+    }
+
+    #[test]
+    fn the_neighbour_radius_weighs_by_depth() {
+        let p = Vec3::ZERO;
+        // Two neighbours at distance 1 with the same depth, one at distance 10 far behind.
+        let nb = [
+            (Vec3::X, 5.0),
+            (Vec3::Y, 5.0),
+            (Vec3::new(10.0, 0.0, 0.0), 50.0),
+        ];
+        let r = radius_from_neighbours(p, 5.0, &nb, 1.0, 1e-3);
+        assert!(r > 1.0 && r < 1.01, "{r}");
+        assert_eq!(radius_from_neighbours(p, 5.0, &[], 1.0, 1e-3), 0.0);
+        assert!((radius_from_neighbours(p, 5.0, &nb[..2], 2.0, 1e-3) - 2.0).abs() < 1e-6);
+    }
+
+    /// The exact contribution in `f64`: constant emission over the cap times the receiver's
+    /// BRDF and clamped cosine, by quadrature over the cap.
+    #[allow(clippy::too_many_arguments)]
+    fn exact(
+        y: [f64; 3],
+        nj: [f64; 3],
+        wl: [f64; 3],
+        r: f64,
+        power: f64,
+        hvl_model: &Model,
+        x: [f64; 3],
+        nx: [f64; 3],
+        wo: [f64; 3],
+        rx_model: &Model,
+    ) -> f64 {
+        let sub = |a: [f64; 3], b: [f64; 3]| [a[0] - b[0], a[1] - b[1], a[2] - b[2]];
+        let dot = |a: [f64; 3], b: [f64; 3]| a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+        let v = sub(y, x);
+        let d = dot(v, v).sqrt();
+        let w = v.map(|c| c / d);
+        let cos_j = -dot(w, nj);
+        if cos_j <= 0.0 {
+            return 0.0;
+        }
+        // Local frames: (t, b, n) with t toward the given tangent direction.
+        let frame = |n: [f64; 3], toward: [f64; 3]| {
+            let k = dot(toward, n);
+            let mut t = [
+                toward[0] - k * n[0],
+                toward[1] - k * n[1],
+                toward[2] - k * n[2],
+            ];
+            let tl = dot(t, t).sqrt();
+            if tl < 1e-12 {
+                t = steradian_reference::perpendiculars(n).0;
+            } else {
+                t = t.map(|c| c / tl);
+            }
+            let b = [
+                n[1] * t[2] - n[2] * t[1],
+                n[2] * t[0] - n[0] * t[2],
+                n[0] * t[1] - n[1] * t[0],
+            ];
+            move |v: [f64; 3]| [dot(v, t), dot(v, b), dot(v, n)]
+        };
+        let fj = frame(nj, wl);
+        let f_emit = hvl_model.rho(fj(wl), fj(w.map(|c| -c)));
+        let le = power * f_emit * cos_j / (core::f64::consts::PI * r * r);
+        let fx = frame(nx, wo);
+        let wo_l = fx(wo);
+        let a = (r / d).min(1.0).asin();
+        let (t1, t2) = steradian_reference::perpendiculars(w);
+        let (gx, gw) = steradian_reference::quad::gauss_legendre(48);
+        let nphi = 256;
+        let mut sum = 0.0;
+        for (xq, wq) in gx.iter().zip(&gw) {
+            let t = 0.5 * a * (1.0 + xq);
+            let (s, c) = t.sin_cos();
+            for j in 0..nphi {
+                let p = (j as f64 + 0.5) * core::f64::consts::TAU / nphi as f64;
+                let dir: [f64; 3] =
+                    core::array::from_fn(|i| c * w[i] + s * (p.cos() * t1[i] + p.sin() * t2[i]));
+                let wi = fx(dir);
+                sum += wq * 0.5 * a * s * core::f64::consts::TAU / nphi as f64
+                    * rx_model.rho_cos(wi, wo_l);
+            }
+        }
+        le * sum
+    }
+
+    fn v3(a: [f64; 3]) -> Vec3 {
+        Vec3::new(a[0] as f32, a[1] as f32, a[2] as f32)
+    }
+
+    /// Relative error per band limit of the HVL contribution against [`exact`], over a few
+    /// placements, for the receiver table `rx` (model `rx_model`) and a Lambert HVL.
+    fn errors(
+        rx: brdf::BrdfSh<'_>,
+        rx_model: &Model,
+        bands: &[usize],
+        horizon: Horizon,
+        table_emission: bool,
+    ) -> Vec<f64> {
+        let lambert = brdf::lambert();
+        let lm = Model::Lambert { a: 1.0 };
+        let x = [0.0, 0.0, 0.0];
+        let nx = [0.0, 0.0, 1.0];
+        let wo = [0.6, 0.0, 0.8];
+        let cases = [
+            // (y, n_j, ω_l, r): overhead, off to the side (glossy direction), grazing.
+            ([-0.6, 0.1, 0.8], [0.0, 0.0, -1.0], [0.3, 0.0, -1.0], 0.15),
+            ([-0.9, 0.0, 1.2], [0.6, 0.0, -0.8], [0.0, 0.5, -1.0], 0.3),
+            ([0.2, 0.5, 1.0], [0.0, -0.6, -0.8], [1.0, 0.0, -1.0], 0.1),
+            ([1.5, 0.3, 0.1], [-1.0, 0.0, 0.0], [-1.0, 0.0, 1.0], 0.2),
+        ];
+        bands
+            .iter()
+            .map(|&n| {
+                let mut coeffs = vec![0.0f32; n * n];
+                let frame = view_frame(v3(nx), v3(wo)).unwrap();
+                rx.lookup_into(Part::WithCosine, math::acosf(0.8), n, &mut coeffs)
+                    .unwrap();
+                let receiver = Receiver {
+                    point: v3(x),
+                    frame,
+                    coeffs: &coeffs,
+                };
+                let (mut num, mut den) = (0.0f64, 0.0f64);
+                for (y, nj, wl, r) in cases {
+                    let nrm = |a: [f64; 3]| {
+                        let l = (a[0] * a[0] + a[1] * a[1] + a[2] * a[2]).sqrt();
+                        a.map(|c| c / l)
+                    };
+                    let (nj, wl) = (nrm(nj), nrm(wl));
+                    let wl_up = wl; // toward the light, on the normal's side
+                    let hvl = Hvl::new(v3(y), v3(nj), v3(wl_up), r as f32, 2.0).unwrap();
+                    let em = if table_emission {
+                        let ne = lambert.bands();
+                        let mut em = vec![0.0; ne * ne];
+                        lambert
+                            .lookup_into(Part::WithoutCosine, hvl.theta_l(), ne, &mut em)
+                            .unwrap();
+                        em
+                    } else {
+                        lambert_emission(1.0).to_vec()
+                    };
+                    let mut scratch = vec![0.0; 400];
+                    let got = contribution(&hvl, &em, &receiver, horizon, &mut scratch).unwrap();
+                    let want = exact(y, nj, wl_up, r, 2.0, &lm, x, nx, wo, rx_model);
+                    num += (f64::from(got) - want).powi(2);
+                    den += want * want;
+                }
+                (num / den).sqrt()
+            })
+            .collect()
+    }
+
+    #[test]
+    fn one_hvl_against_the_exact_integral_per_band_limit() {
+        let lm = Model::Lambert { a: 1.0 };
+        let pm = Model::Phong {
+            kd: 0.0,
+            ks: 1.0,
+            e: 30.0,
+        };
+        let d = errors(brdf::lambert(), &lm, &[1, 2, 3, 5], Horizon::Exact, false);
+        let g = errors(brdf::phong(), &pm, &[3, 5, 7, 9, 14], Horizon::Exact, false);
+        let ds = errors(brdf::lambert(), &lm, &[5], Horizon::Smoothstep, false);
+        let gs = errors(brdf::phong(), &pm, &[14], Horizon::Smoothstep, false);
+        let dt = errors(brdf::lambert(), &lm, &[5], Horizon::Exact, true);
+        println!("diffuse receiver, bands 1 2 3 5: {d:.4?}");
+        println!("glossy receiver, bands 3 5 7 9 14: {g:.4?}");
+        println!("smoothstep H: diffuse 5 bands {ds:.4?}, glossy 14 bands {gs:.4?}");
+        println!("diffuse 5 bands, emission from the 5-band F′ table: {dt:.4?}");
+        // The figures of the module docs.
+        assert!(d[2] <= 0.022 && d[3] <= 0.016, "{d:?}");
+        assert!(
+            g.windows(2).all(|w| w[1] < w[0]) && g[3] <= 0.18 && g[4] <= 0.014,
+            "{g:?}"
+        );
+        assert!(ds[0] <= 0.016 && gs[0] <= 0.014, "{ds:?} {gs:?}");
+        assert!(dt[0] > 0.1 && dt[0] < 0.13, "{dt:?}");
+    }
+}
