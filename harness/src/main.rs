@@ -40,6 +40,10 @@ enum Command {
         /// Skip the wgpu backend.
         #[arg(long)]
         no_gpu: bool,
+        /// Run only the section with this id (its key in report.json: lobe-product, sat,
+        /// brdf_sat, lobe-sum, vdt, rsl, shade, sh), not the top table.
+        #[arg(long)]
+        section: Option<String>,
     },
     /// Evaluate a kernel on JSON Lines from stdin, one JSON line out per line in.
     #[command(after_help = eval::help())]
@@ -66,6 +70,7 @@ fn main() -> ExitCode {
             repeats,
             error_rows,
             no_gpu,
+            section,
         } => {
             let opts = report::Options {
                 out,
@@ -73,6 +78,7 @@ fn main() -> ExitCode {
                 repeats,
                 error_rows,
                 gpu: !no_gpu,
+                only: section,
             };
             match report::run(&opts) {
                 Ok(r) => {

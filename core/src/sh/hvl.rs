@@ -440,76 +440,6 @@ mod tests {
         assert!((radius_from_neighbours(p, 5.0, &nb[..2], 2.0, 1e-3) - 2.0).abs() < 1e-6);
     }
 
-    /// The exact contribution in `f64`: constant emission over the cap times the receiver's
-    /// BRDF and clamped cosine, by quadrature over the cap.
-    #[allow(clippy::too_many_arguments)]
-    fn exact(
-        y: [f64; 3],
-        nj: [f64; 3],
-        wl: [f64; 3],
-        r: f64,
-        power: f64,
-        hvl_model: &Model,
-        x: [f64; 3],
-        nx: [f64; 3],
-        wo: [f64; 3],
-        rx_model: &Model,
-    ) -> f64 {
-        let sub = |a: [f64; 3], b: [f64; 3]| [a[0] - b[0], a[1] - b[1], a[2] - b[2]];
-        let dot = |a: [f64; 3], b: [f64; 3]| a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
-        let v = sub(y, x);
-        let d = dot(v, v).sqrt();
-        let w = v.map(|c| c / d);
-        let cos_j = -dot(w, nj);
-        if cos_j <= 0.0 {
-            return 0.0;
-        }
-        // Local frames: (t, b, n) with t toward the given tangent direction.
-        let frame = |n: [f64; 3], toward: [f64; 3]| {
-            let k = dot(toward, n);
-            let mut t = [
-                toward[0] - k * n[0],
-                toward[1] - k * n[1],
-                toward[2] - k * n[2],
-            ];
-            let tl = dot(t, t).sqrt();
-            if tl < 1e-12 {
-                t = steradian_reference::perpendiculars(n).0;
-            } else {
-                t = t.map(|c| c / tl);
-            }
-            let b = [
-                n[1] * t[2] - n[2] * t[1],
-                n[2] * t[0] - n[0] * t[2],
-                n[0] * t[1] - n[1] * t[0],
-            ];
-            move |v: [f64; 3]| [dot(v, t), dot(v, b), dot(v, n)]
-        };
-        let fj = frame(nj, wl);
-        let f_emit = hvl_model.rho(fj(wl), fj(w.map(|c| -c)));
-        let le = power * f_emit * cos_j / (core::f64::consts::PI * r * r);
-        let fx = frame(nx, wo);
-        let wo_l = fx(wo);
-        let a = (r / d).min(1.0).asin();
-        let (t1, t2) = steradian_reference::perpendiculars(w);
-        let (gx, gw) = steradian_reference::quad::gauss_legendre(48);
-        let nphi = 256;
-        let mut sum = 0.0;
-        for (xq, wq) in gx.iter().zip(&gw) {
-            let t = 0.5 * a * (1.0 + xq);
-            let (s, c) = t.sin_cos();
-            for j in 0..nphi {
-                let p = (j as f64 + 0.5) * core::f64::consts::TAU / nphi as f64;
-                let dir: [f64; 3] =
-                    core::array::from_fn(|i| c * w[i] + s * (p.cos() * t1[i] + p.sin() * t2[i]));
-                let wi = fx(dir);
-                sum += wq * 0.5 * a * s * core::f64::consts::TAU / nphi as f64
-                    * rx_model.rho_cos(wi, wo_l);
-            }
-        }
-        le * sum
-    }
-
     fn v3(a: [f64; 3]) -> Vec3 {
         Vec3::new(a[0] as f32, a[1] as f32, a[2] as f32)
     }
@@ -568,7 +498,21 @@ mod tests {
                     };
                     let mut scratch = vec![0.0; 400];
                     let got = contribution(&hvl, &em, &receiver, horizon, &mut scratch).unwrap();
-                    let want = exact(y, nj, wl_up, r, 2.0, &lm, x, nx, wo, rx_model);
+                    let want = steradian_reference::sh::hvl::contribution(
+                        &steradian_reference::sh::hvl::Light {
+                            position: y,
+                            normal: nj,
+                            to_light: wl_up,
+                            radius: r,
+                            power: 2.0,
+                            model: lm,
+                        },
+                        x,
+                        nx,
+                        wo,
+                        rx_model,
+                        48,
+                    );
                     num += (f64::from(got) - want).powi(2);
                     den += want * want;
                 }

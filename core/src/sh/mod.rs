@@ -261,15 +261,19 @@ pub fn unit_direction(d: Vec3) -> DVec3 {
     s / math::sqrt64(s.dot(s))
 }
 
-/// The recurrence over `bands` bands at the direction `d` (unit to `f32` rounding) into
-/// `out[..bands²]` (`bands ≤ MAX_BANDS`, `out.len() ≥ bands²`: checked by the callers).
-/// Shared by the fixed-size and the dynamic entry points, so both give the same bits.
+/// The recurrence over `bands` bands at the unit direction `d` into `out[..bands²]`
+/// (`bands ≤ MAX_BANDS`, `out.len() ≥ bands²`: checked by the callers). Shared by the
+/// fixed-size and the dynamic entry points, so both give the same bits.
 ///
-/// The recurrence runs in `f64` on the `f32` inputs and coefficients, one rounding to `f32`
-/// per output (module docs, "Accuracy"), and in its homogeneous form
-/// `Π_l = a·(z·Π_{l−1} − b·r²·Π_{l−2})` with `r² = x² + y² + z²` of the given point, so that
-/// the point's distance from the sphere (a few `1e-8` for an `f32` unit vector) only scales
-/// band `l` by `r^l` instead of being amplified by the Legendre coefficients.
+/// The recurrence runs in `f64`, one rounding to `f32` per output (module docs,
+/// "Accuracy"), in its homogeneous form `Π_l = a·(z·Π_{l−1} − b·r²·Π_{l−2})`.
+///
+/// **Two chains at a time.** The recurrence in `l` is a chain of dependent multiplications
+/// per `m` (about 12 cycles of latency per step), so one chain at a time leaves the
+/// arithmetic units idle; the orders `m` and `m + 1` run in the same loop, their steps
+/// independent. Each value is computed by the same operations in the same order as one
+/// chain at a time, so the bits do not depend on the pairing (the SIMD twin runs one chain
+/// at a time and is tested bit for bit).
 #[inline(always)]
 fn fill(d: DVec3, bands: usize, out: &mut [f32]) {
     let out = &mut out[..bands * bands];
@@ -293,30 +297,54 @@ fn fill(d: DVec3, bands: usize, out: &mut [f32]) {
         out[l * l + l] = p as f32;
         (p2, p1) = (p1, p);
     }
-    // m ≥ 1: √2·Π_l^m times C_m and S_m.
+    // m ≥ 1: √2·Π_l^m times C_m and S_m, two orders per pass.
+    let put = |out: &mut [f32], l: usize, m: usize, q: f64, c: f64, s: f64| {
+        let at = l * l + l;
+        out[at + m] = (q * c) as f32;
+        out[at - m] = (q * s) as f32;
+    };
+    let step = |l: usize, m: usize, q1: f64, q2: f64| {
+        let k = tri(l, m);
+        A[k] * (z * q1 - B[k] * r2 * q2)
+    };
     let (mut pmm, mut c, mut s) = (y00, 1.0f64, 0.0f64);
-    for m in 1..bands {
+    let mut m = 1;
+    while m < bands {
+        // Order m.
         pmm *= DIAG[m];
         (c, s) = (x * c - y * s, x * s + y * c);
-        let mut q2 = core::f64::consts::SQRT_2 * pmm;
-        let at = m * m + m;
-        out[at + m] = (q2 * c) as f32;
-        out[at - m] = (q2 * s) as f32;
+        let (ca, sa) = (c, s);
+        let mut a2 = core::f64::consts::SQRT_2 * pmm;
+        put(out, m, m, a2, ca, sa);
         if m + 1 == bands {
             break;
         }
-        let mut q1 = SUB[m] * z * q2;
-        let at = at + 2 * m + 2;
-        out[at + m] = (q1 * c) as f32;
-        out[at - m] = (q1 * s) as f32;
-        for l in m + 2..bands {
-            let k = tri(l, m);
-            let q = A[k] * (z * q1 - B[k] * r2 * q2);
-            let at = l * l + l;
-            out[at + m] = (q * c) as f32;
-            out[at - m] = (q * s) as f32;
-            (q2, q1) = (q1, q);
+        let mut a1 = SUB[m] * z * a2;
+        put(out, m + 1, m, a1, ca, sa);
+        // Order m + 1 (it exists: m + 1 < bands).
+        pmm *= DIAG[m + 1];
+        (c, s) = (x * c - y * s, x * s + y * c);
+        let (cb, sb) = (c, s);
+        let mut b2 = core::f64::consts::SQRT_2 * pmm;
+        put(out, m + 1, m + 1, b2, cb, sb);
+        if m + 2 == bands {
+            break;
         }
+        let q = step(m + 2, m, a1, a2);
+        put(out, m + 2, m, q, ca, sa);
+        (a2, a1) = (a1, q);
+        let mut b1 = SUB[m + 1] * z * b2;
+        put(out, m + 2, m + 1, b1, cb, sb);
+        // Both chains together.
+        for l in m + 3..bands {
+            let qa = step(l, m, a1, a2);
+            let qb = step(l, m + 1, b1, b2);
+            put(out, l, m, qa, ca, sa);
+            put(out, l, m + 1, qb, cb, sb);
+            (a2, a1) = (a1, qa);
+            (b2, b1) = (b1, qb);
+        }
+        m += 2;
     }
 }
 

@@ -10,6 +10,7 @@ pub mod rsl;
 pub mod sat;
 pub mod section;
 pub mod sections;
+pub mod sh;
 pub mod shade;
 pub mod timing;
 pub mod vdt;
@@ -51,6 +52,8 @@ pub struct Options {
     pub error_rows: usize,
     /// Try the wgpu backend.
     pub gpu: bool,
+    /// Run only the section with this id (and not the top table).
+    pub only: Option<String>,
 }
 
 impl Default for Options {
@@ -61,6 +64,7 @@ impl Default for Options {
             repeats: 7,
             error_rows: 1 << 16,
             gpu: true,
+            only: None,
         }
     }
 }
@@ -176,7 +180,13 @@ pub fn run(opts: &Options) -> Result<Report, Box<dyn std::error::Error>> {
             .unwrap_or_else(|_| ProgressStyle::default_bar()),
     );
     let mut results = Vec::new();
-    for k in registry::batch_kernels() {
+    // With one section asked for, the top table is skipped.
+    let top = if opts.only.is_some() {
+        None
+    } else {
+        Some(registry::batch_kernels())
+    };
+    for k in top.into_iter().flatten() {
         bar.set_message(format!("{k}: inputs and f64 reference"));
         let input = workload::generate(k, opts.n, SEED);
         let reference = accuracy::reference(k, &input, opts.error_rows);

@@ -6,18 +6,33 @@
 use super::Options;
 pub use super::section::{Producer, Section};
 
-/// Every section, in report order.
-pub const PRODUCERS: &[Producer] = &[
-    super::product::section,
-    super::sat::section,
-    super::brdf::section,
-    super::lobe_sum::section,
-    super::vdt::section,
-    super::rsl::section,
-    super::shade::section,
+/// Every section with its id (its key in `report.json`), in report order.
+pub const PRODUCERS: &[(&str, Producer)] = &[
+    ("lobe-product", super::product::section),
+    ("sat", super::sat::section),
+    ("brdf_sat", super::brdf::section),
+    ("lobe-sum", super::lobe_sum::section),
+    ("vdt", super::vdt::section),
+    ("rsl", super::rsl::section),
+    ("shade", super::shade::section),
+    ("sh", super::sh::section),
 ];
 
-/// Runs every section producer.
+/// Runs every section producer, or only the one `opts.only` names.
 pub fn run_all(opts: &Options) -> Result<Vec<Section>, Box<dyn std::error::Error>> {
-    PRODUCERS.iter().map(|p| p(opts)).collect()
+    if let Some(id) = &opts.only
+        && !PRODUCERS.iter().any(|(p, _)| p == id)
+    {
+        let ids: Vec<&str> = PRODUCERS.iter().map(|(p, _)| *p).collect();
+        return Err(format!("no report section {id:?}; the sections are {ids:?}").into());
+    }
+    PRODUCERS
+        .iter()
+        .filter(|(id, _)| opts.only.as_deref().is_none_or(|o| o == *id))
+        .map(|(id, p)| {
+            let s = p(opts)?;
+            debug_assert_eq!(s.id, *id);
+            Ok(s)
+        })
+        .collect()
 }

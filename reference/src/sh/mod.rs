@@ -9,6 +9,8 @@
 //!
 //! Those of `steradian_core::sh` (the HVL paper, eq. 7–8).
 
+pub mod hvl;
+
 use std::f64::consts::PI;
 
 /// `ln k!`.

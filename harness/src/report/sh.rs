@@ -1,0 +1,466 @@
+//! Report section: spherical harmonics and Harmonics Virtual Lights. Evaluation speed at 3–30
+//! bands (scalar, SIMD) against a plain `f64` evaluation and the `sphrs` crate on the same
+//! directions in the same run, with a convention-free correctness check of each and the
+//! machine's multiply–add rate; rotation (ZXZXZ per vector, the built operator) and cap
+//! projection speed; the HVL paper's Table 1 (band limit × HVL count → time per shading
+//! point and error against the exact integral); the BRDF tables' truncation error per band
+//! limit with and without windows; and the windows' negativity.
+
+use std::error::Error;
+use std::fmt::Write as _;
+use std::hint::black_box;
+
+use serde_json::json;
+use steradian_core::Vec3;
+use steradian_core::sh::{self, rotate, window::Window};
+
+use super::Options;
+use super::section::Section;
+use super::timing::{median_time, median_times_in_turns, ns_per};
+use crate::generate::brdf_sh;
+use crate::sh as study;
+
+const SEED: u64 = 0x0005_4a11;
+/// Band counts of the evaluation table.
+pub const EVAL_BANDS: [usize; 5] = [3, 5, 10, 20, 30];
+/// Band counts of the rotation table.
+pub const ROTATE_BANDS: [usize; 4] = [3, 5, 10, 30];
+/// Band limits of Table 1.
+pub const HVL_BANDS: [usize; 4] = [3, 5, 7, 9];
+/// HVL counts of Table 1 (`side²`).
+pub const HVL_SIDES: [usize; 3] = [8, 14, 20];
+
+/// One row of the evaluation table.
+struct EvalRow {
+    bands: usize,
+    ns: [f64; 4],
+    identity: [f64; 4],
+}
+
+fn eval_rows(opts: &Options) -> Vec<EvalRow> {
+    let dirs = study::directions(opts.scaled(4096).max(64), SEED);
+    EVAL_BANDS
+        .iter()
+        .map(|&n| {
+            let nn = n * n;
+            // sphrs costs O(n⁴)-ish: fewer directions for it at high band counts.
+            let peer_dirs = if n >= 20 { 16 } else { dirs.len().min(1024) };
+            let norms = study::plain_norms(n);
+            let set = study::sphrs_set(n);
+            let (x, y, z): (Vec<f32>, Vec<f32>, Vec<f32>) = (
+                dirs.iter().map(|d| d[0]).collect(),
+                dirs.iter().map(|d| d[1]).collect(),
+                dirs.iter().map(|d| d[2]).collect(),
+            );
+            let chunk = 64;
+            let mut out = vec![0.0f32; nn];
+            let mut cols = vec![0.0f32; nn * chunk];
+            let mut plain = vec![0.0f64; nn];
+            let counts = [dirs.len(), dirs.len(), dirs.len(), peer_dirs];
+            let t = median_times_in_turns(opts.repeats.min(5), 4, |k| match k {
+                0 => {
+                    for d in &dirs {
+                        sh::eval_into(Vec3::from(*d), n, &mut out).expect("shape");
+                        black_box(&out);
+                    }
+                }
+                1 => {
+                    for s in (0..dirs.len()).step_by(chunk) {
+                        let e = (s + chunk).min(dirs.len());
+                        let len = e - s;
+                        steradian_simd::sh::eval_slices(
+                            &x[s..e],
+                            &y[s..e],
+                            &z[s..e],
+                            n,
+                            &mut cols[..nn * len],
+                        )
+                        .expect("shape");
+                        black_box(&cols);
+                    }
+                }
+                2 => {
+                    for d in &dirs {
+                        study::plain_eval(d.map(f64::from), n, &norms, &mut plain);
+                        black_box(&plain);
+                    }
+                }
+                _ => {
+                    for d in &dirs[..peer_dirs] {
+                        black_box(study::sphrs_eval(&set, d.map(f64::from)));
+                    }
+                }
+            });
+            let ns = std::array::from_fn(|k| ns_per(counts[k], t[k]));
+            // Correctness on 64 directions, every implementation.
+            let mut identity = [0.0f64; 4];
+            for d in dirs.iter().take(64) {
+                sh::eval_into(Vec3::from(*d), n, &mut out).expect("shape");
+                let ours: Vec<f64> = out.iter().map(|&v| f64::from(v)).collect();
+                study::plain_eval(d.map(f64::from), n, &norms, &mut plain);
+                let peer = study::sphrs_eval(&set, d.map(f64::from));
+                let errs = [
+                    study::band_identity_error(&ours, n),
+                    study::band_identity_error(&ours, n),
+                    study::band_identity_error(&plain, n),
+                    if peer.len() == nn && peer.iter().all(|v| v.is_finite()) {
+                        study::band_identity_error(&peer, n)
+                    } else {
+                        f64::INFINITY
+                    },
+                ];
+                for (a, b) in identity.iter_mut().zip(errs) {
+                    *a = a.max(b);
+                }
+            }
+            EvalRow {
+                bands: n,
+                ns,
+                identity,
+            }
+        })
+        .collect()
+}
+
+struct RotateRow {
+    bands: usize,
+    zxzxz_ns: f64,
+    build_ns: f64,
+    apply_ns: f64,
+}
+
+fn rotate_rows(opts: &Options) -> Vec<RotateRow> {
+    let rot = rotate::Rotation::from_axis_angle(Vec3::new(0.3, -0.5, 0.8), 1.1).expect("valid");
+    ROTATE_BANDS
+        .iter()
+        .map(|&n| {
+            let vectors = opts.scaled(if n >= 30 { 64 } else { 1024 }).max(8);
+            let input: Vec<f32> = (0..n * n).map(|i| ((i * 7919) % 13) as f32 - 6.0).collect();
+            let mut out = vec![0.0f32; n * n];
+            let rz = rotate::Rotator::new(n).expect("bands");
+            let zx = median_time(opts.repeats, || {
+                for _ in 0..vectors {
+                    rz.rotate(&rot, black_box(&input), &mut out).expect("shape");
+                }
+                black_box(&out);
+            });
+            let build = median_time(opts.repeats, || {
+                black_box(rotate::Operator::new(&rot, n).expect("bands"));
+            });
+            let op = rotate::Operator::new(&rot, n).expect("bands");
+            let apply = median_time(opts.repeats, || {
+                for _ in 0..vectors {
+                    op.apply(black_box(&input), &mut out).expect("shape");
+                }
+                black_box(&out);
+            });
+            RotateRow {
+                bands: n,
+                zxzxz_ns: ns_per(vectors, zx),
+                build_ns: build.as_secs_f64() * 1e9,
+                apply_ns: ns_per(vectors, apply),
+            }
+        })
+        .collect()
+}
+
+fn cap_rows(opts: &Options) -> Vec<(usize, f64)> {
+    let dirs = study::directions(opts.scaled(4096).max(64), SEED ^ 1);
+    [3usize, 5, 9]
+        .iter()
+        .map(|&n| {
+            let mut out = vec![0.0f32; n * n];
+            let t = median_time(opts.repeats, || {
+                for (i, d) in dirs.iter().enumerate() {
+                    let a = 0.01 + (i % 100) as f32 * 0.01;
+                    sh::cap::coefficients_into(Vec3::from(*d), a, n, &mut out).expect("shape");
+                    black_box(&out);
+                }
+            });
+            (n, ns_per(dirs.len(), t))
+        })
+        .collect()
+}
+
+/// Table 1: `[side][bands]` → (µs per shading point, error per material).
+struct Table1 {
+    rows: Vec<(usize, usize, f64, [f64; 2])>,
+}
+
+fn table1(opts: &Options) -> Table1 {
+    let mats = study::materials();
+    let mut rows = Vec::new();
+    for &side in &HVL_SIDES {
+        let scene = study::hvl_scene(side);
+        let exact: Vec<Vec<f64>> = mats
+            .iter()
+            .map(|m| study::shade_exact(&scene, &m.model))
+            .collect();
+        for &n in &HVL_BANDS {
+            let mut errs = [0.0f64; 2];
+            let mut us = 0.0;
+            for (k, m) in mats.iter().enumerate() {
+                let (got, _) = study::shade(&scene, m, n);
+                errs[k] = study::rel_rms(&got, &exact[k]);
+                if k == 1 {
+                    let t = median_time(opts.repeats.min(5), || {
+                        black_box(study::shade(&scene, m, n));
+                    });
+                    us = t.as_secs_f64() * 1e6 / scene.points.len() as f64;
+                }
+            }
+            rows.push((side * side, n, us, errs));
+        }
+    }
+    Table1 { rows }
+}
+
+/// Per built-in material: (name, bands, samples, bytes, errors at [3, 5, 7, 9, 11, 14] for
+/// no window, Hanning, Cesàro).
+type BrdfRow = (&'static str, usize, usize, usize, [[f64; 6]; 3]);
+
+fn brdf_rows() -> Vec<BrdfRow> {
+    let limits = [3usize, 5, 7, 9, 11, 14];
+    brdf_sh::materials()
+        .iter()
+        .map(|m| {
+            let bands = brdf_sh::choose_bands(&m.model, brdf_sh::TARGET).max(3);
+            let samples = brdf_sh::choose_samples(&m.model, bands, brdf_sh::TARGET);
+            let bytes =
+                steradian_core::table::HEADER_LEN + 4 * samples * 2 * sh::brdf::stored(bands);
+            let nodes = brdf_sh::Nodes::new(m.model.feature_angle(), brdf_sh::MAX_BANDS, 1);
+            let (f, _, n2, _) = brdf_sh::project(&m.model, &nodes, std::f64::consts::FRAC_PI_4);
+            let errs = [Window::None, Window::Hanning, Window::Cesaro].map(|w| {
+                let e =
+                    brdf_sh::truncation_errors(&f, n2, brdf_sh::MAX_BANDS, |l, n| w.weight(l, n));
+                limits.map(|n| e[n - 1])
+            });
+            (m.name, bands, samples, bytes, errs)
+        })
+        .collect()
+}
+
+/// Per window: the most negative value (peak 1) of caps of 0.05–2.5 rad and the clamped
+/// cosine over 2–40 bands.
+fn window_rows() -> Vec<(&'static str, f64)> {
+    let windows = [
+        ("none", Window::None),
+        ("Hanning", Window::Hanning),
+        ("Lanczos", Window::Lanczos),
+        ("sinc⁴", Window::Sinc { power: 4 }),
+        ("pbrt damping λ = 0.005", Window::Damping { lambda: 0.005 }),
+        ("Cesàro (C, 2)", Window::Cesaro),
+    ];
+    let ts: Vec<f64> = (0..=600).map(|i| -1.0 + i as f64 / 300.0).collect();
+    windows
+        .iter()
+        .map(|(name, w)| {
+            let mut worst = 0.0f64;
+            for n in 2..=40 {
+                let mut lobes: Vec<Vec<f64>> = [0.05f32, 0.3, 1.0, 2.5]
+                    .iter()
+                    .map(|&a| {
+                        let mut z = vec![0.0f32; n];
+                        sh::cap::zonal_into(a, n, &mut z).expect("shape");
+                        z.iter().map(|&v| f64::from(v)).collect()
+                    })
+                    .collect();
+                lobes.push(
+                    (0..n)
+                        .map(|l| sh::irradiance::clamped_cosine(l) / sh::convolve::funk_hecke(l))
+                        .collect(),
+                );
+                for c in &lobes {
+                    for &t in &ts {
+                        let (mut p0, mut p1) = (1.0f64, t);
+                        let mut s = 0.0;
+                        for (l, cl) in c.iter().enumerate() {
+                            let p = if l == 0 { 1.0 } else { p1 };
+                            s += w.weight(l, n)
+                                * cl
+                                * ((2 * l + 1) as f64 / (4.0 * std::f64::consts::PI)).sqrt()
+                                * p;
+                            if l >= 1 {
+                                let lf = l as f64;
+                                (p0, p1) = (p1, ((2.0 * lf + 1.0) * t * p1 - lf * p0) / (lf + 1.0));
+                            }
+                        }
+                        worst = worst.min(s);
+                    }
+                }
+            }
+            (*name, worst)
+        })
+        .collect()
+}
+
+/// The section.
+pub fn section(opts: &Options) -> Result<Section, Box<dyn Error>> {
+    let rate = study::mul_add_rate();
+    let eval = eval_rows(opts);
+    let rot = rotate_rows(opts);
+    let caps = cap_rows(opts);
+    let t1 = table1(opts);
+    let brdf = brdf_rows();
+    let windows = window_rows();
+
+    let mut html = String::new();
+    let mut summary = String::new();
+    writeln!(
+        html,
+        "<h3>Evaluation</h3><p>ns per direction, all n² functions; the plain f64 evaluation and \
+         <code>sphrs</code> 0.2.2 on the same directions in the same run (taking turns). \
+         Correctness: the largest relative departure from the addition theorem \
+         Σ<sub>m</sub> Y<sub>l</sub><sup>m</sup>² = (2l+1)/4π over 64 directions (convention-free). \
+         Multiply–add rate of this binary: {rate:.2} pairs/ns; at three multiplications per \
+         coefficient the recurrence could reach {:.2} coefficients/ns.</p>",
+        rate / 3.0
+    )?;
+    html.push_str("<table><tr><th>bands</th><th>scalar</th><th>SIMD</th><th>plain f64</th><th>sphrs</th><th>scalar / plain</th><th>SIMD / scalar</th><th>coeff/ns (of op-count limit)</th><th>identity error: ours, plain, sphrs</th></tr>");
+    for r in &eval {
+        let cpn = (r.bands * r.bands) as f64 / r.ns[0];
+        writeln!(
+            html,
+            "<tr><td>{}</td><td>{:.1}</td><td>{:.1}</td><td>{:.1}</td><td>{:.1}</td><td>{:.2}×</td><td>{:.2}×</td><td>{:.2} ({:.0} %)</td><td>{:.1e}, {:.1e}, {:.1e}</td></tr>",
+            r.bands,
+            r.ns[0],
+            r.ns[1],
+            r.ns[2],
+            r.ns[3],
+            r.ns[2] / r.ns[0],
+            r.ns[0] / r.ns[1],
+            cpn,
+            100.0 * cpn / (rate / 3.0),
+            r.identity[0],
+            r.identity[2],
+            r.identity[3]
+        )?;
+        writeln!(
+            summary,
+            "sh-eval {:2} bands: scalar {:.1} ns, SIMD {:.1} ns, plain f64 {:.1} ns ({:.2}× ours), sphrs {:.1} ns (identity error {:.1e})",
+            r.bands,
+            r.ns[0],
+            r.ns[1],
+            r.ns[2],
+            r.ns[2] / r.ns[0],
+            r.ns[3],
+            r.identity[3]
+        )?;
+    }
+    html.push_str("</table>");
+
+    html.push_str("<h3>Rotation</h3><table><tr><th>bands</th><th>ZXZXZ per vector (ns)</th><th>operator build (ns)</th><th>operator apply per vector (ns)</th><th>vectors to break even</th></tr>");
+    for r in &rot {
+        let even = r.build_ns / (r.zxzxz_ns - r.apply_ns).max(1e-9);
+        writeln!(
+            html,
+            "<tr><td>{}</td><td>{:.0}</td><td>{:.0}</td><td>{:.0}</td><td>{}</td></tr>",
+            r.bands,
+            r.zxzxz_ns,
+            r.build_ns,
+            r.apply_ns,
+            if r.zxzxz_ns > r.apply_ns {
+                format!("{even:.1}")
+            } else {
+                "never".into()
+            }
+        )?;
+    }
+    html.push_str("</table>");
+    writeln!(
+        summary,
+        "sh-rotate: {}",
+        rot.iter()
+            .map(|r| format!("{} bands {:.0} ns (ZXZXZ)", r.bands, r.zxzxz_ns))
+            .collect::<Vec<_>>()
+            .join(", ")
+    )?;
+
+    html.push_str("<h3>Cap projection (zonal coefficients and their rotation to the axis)</h3><table><tr><th>bands</th><th>ns per cap</th><th>caps per second</th></tr>");
+    for (n, ns) in &caps {
+        writeln!(
+            html,
+            "<tr><td>{n}</td><td>{ns:.1}</td><td>{:.2e}</td></tr>",
+            1e9 / ns
+        )?;
+    }
+    html.push_str("</table>");
+
+    html.push_str(
+        "<h3>HVL shading (the paper's Table 1)</h3><p>A spot light (90° field of view, \
+         10 W/sr) 3 above a Lambertian floor (albedo 0.8) places M HVLs by a square \
+         reflective shadow map, radius r2 (eq. 25, k = 1); 48 receivers on a wall beside it \
+         seen from one eye. Time: all M contributions per shading point, scalar, smoothstep H, \
+         Phong 30 receiver. Error: relative RMS over the receivers against the exact integral \
+         of the same spherical lights (steradian_reference::sh::hvl). The Lambert table has 5 \
+         bands, so its rows at 7 and 9 bands are its 5-band figures.</p>\
+         <table><tr><th>M</th><th>bands</th><th>µs per point</th><th>error, Lambert</th><th>error, Phong 30</th></tr>",
+    );
+    for (m, n, us, e) in &t1.rows {
+        writeln!(
+            html,
+            "<tr><td>{m}</td><td>{n}</td><td>{us:.1}</td><td>{:.4}</td><td>{:.4}</td></tr>",
+            e[0], e[1]
+        )?;
+    }
+    html.push_str("</table>");
+    if let Some((m, n, us, e)) = t1.rows.last() {
+        writeln!(
+            summary,
+            "HVL: {m} lights at {n} bands: {us:.1} µs per point, error {:.3} (Lambert) {:.3} (Phong 30)",
+            e[0], e[1]
+        )?;
+    }
+
+    html.push_str("<h3>BRDF SH tables</h3><p>Relative L2 truncation error of F at θₒ = 45° (Parseval on 16 bands of coefficients), without a window / Hanning / Cesàro, per band limit.</p><table><tr><th>material</th><th>table (bands × views, bytes)</th><th>window</th><th>3</th><th>5</th><th>7</th><th>9</th><th>11</th><th>14</th></tr>");
+    for (name, bands, samples, bytes, errs) in &brdf {
+        for (k, w) in ["none", "Hanning", "Cesàro"].iter().enumerate() {
+            write!(
+                html,
+                "<tr><td>{name}</td><td>{bands} × {samples}, {bytes}</td><td>{w}</td>"
+            )?;
+            for e in errs[k] {
+                write!(html, "<td>{e:.3}</td>")?;
+            }
+            html.push_str("</tr>");
+        }
+    }
+    html.push_str("</table>");
+
+    html.push_str("<h3>Windows</h3><p>The most negative reconstructed value (the lobes peak at 1) of caps of 0.05, 0.3, 1 and 2.5 rad and of max(cos θ, 0), over 2–40 bands.</p><table><tr><th>window</th><th>most negative value</th></tr>");
+    for (name, v) in &windows {
+        writeln!(html, "<tr><td>{name}</td><td>{v:.4}</td></tr>")?;
+    }
+    html.push_str("</table>");
+
+    let data = json!({
+        "mul_add_pairs_per_ns": rate,
+        "eval": eval.iter().map(|r| json!({
+            "bands": r.bands,
+            "ns_per_dir": {"scalar": r.ns[0], "simd": r.ns[1], "plain_f64": r.ns[2], "sphrs": r.ns[3]},
+            "identity_error": {"ours": r.identity[0], "plain_f64": r.identity[2], "sphrs": r.identity[3]},
+        })).collect::<Vec<_>>(),
+        "rotate": rot.iter().map(|r| json!({
+            "bands": r.bands, "zxzxz_ns": r.zxzxz_ns, "operator_build_ns": r.build_ns,
+            "operator_apply_ns": r.apply_ns,
+        })).collect::<Vec<_>>(),
+        "cap_ns": caps.iter().map(|(n, ns)| json!({"bands": n, "ns": ns})).collect::<Vec<_>>(),
+        "hvl_table1": t1.rows.iter().map(|(m, n, us, e)| json!({
+            "hvls": m, "bands": n, "us_per_point": us, "error_lambert": e[0], "error_phong30": e[1],
+        })).collect::<Vec<_>>(),
+        "brdf_tables": brdf.iter().map(|(name, bands, samples, bytes, errs)| json!({
+            "material": name, "bands": bands, "views": samples, "bytes": bytes,
+            "band_limits": [3, 5, 7, 9, 11, 14],
+            "error": {"none": errs[0], "hanning": errs[1], "cesaro": errs[2]},
+        })).collect::<Vec<_>>(),
+        "windows": windows.iter().map(|(n, v)| json!({"window": n, "most_negative": v})).collect::<Vec<_>>(),
+    });
+    Ok(Section {
+        id: "sh",
+        title: "Spherical harmonics and Harmonics Virtual Lights".into(),
+        summary,
+        html,
+        data,
+        files: Vec::new(),
+    })
+}
