@@ -2,9 +2,47 @@
 //! bit for any direction (NaN, ±∞, subnormal components included) at 1–12 bands; every value
 //! is finite for every finite non-zero direction; the cap coefficients are finite for any
 //! finite direction and any half-angle in `[0, π]` (an error outside, never a panic); the
-//! irradiance of finite coefficients at a finite normal is finite.
+//! irradiance of finite coefficients at a finite normal is finite; a rotation that passes
+//! validation (nine arbitrary entries, or an arbitrary axis and angle) preserves every
+//! band's norm on both paths (ZXZXZ and the built operator), which agree.
 
+use steradian_core::sh::rotate::{Operator, Rotation, Rotator, rotate_rel_error};
 use steradian_core::{Vec3, sh};
+
+/// Both rotation paths on `c` (`bands` bands): finite, every band's norm kept, and equal.
+fn check_rotation(rot: &Rotation, c: &[f32], bands: usize) {
+    let n = bands * bands;
+    let (mut a, mut b) = (vec![0.0f32; n], vec![0.0f32; n]);
+    Rotator::new(bands)
+        .expect("bands")
+        .rotate(rot, c, &mut a)
+        .expect("shape");
+    Operator::new(rot, bands)
+        .expect("bands")
+        .apply(c, &mut b)
+        .expect("shape");
+    let tol = 4.0 * f64::from(rotate_rel_error(bands));
+    let norm = |v: &[f32]| v.iter().map(|&x| f64::from(x).powi(2)).sum::<f64>().sqrt();
+    let total = norm(c);
+    for l in 0..bands {
+        let r = l * l..(l + 1) * (l + 1);
+        let (n0, na, nb) = (norm(&c[r.clone()]), norm(&a[r.clone()]), norm(&b[r]));
+        assert!(
+            (na - n0).abs() <= tol * n0 + 1e-30 && (nb - n0).abs() <= tol * n0 + 1e-30,
+            "band {l}: {n0} → {na} / {nb}"
+        );
+    }
+    let diff: f64 = a
+        .iter()
+        .zip(&b)
+        .map(|(x, y)| (f64::from(*x) - f64::from(*y)).powi(2))
+        .sum::<f64>()
+        .sqrt();
+    assert!(
+        diff <= 2.0 * tol * total + 1e-30,
+        "paths differ by {diff} of {total}"
+    );
+}
 
 fn f32_at(d: &[u8], at: usize) -> f32 {
     let b: [u8; 4] = core::array::from_fn(|k| d.get(at + k).copied().unwrap_or(0));
@@ -55,6 +93,18 @@ pub fn check(data: &[u8]) {
                 let mut scratch = vec![0.0f32; n];
                 let e = sh::irradiance::irradiance(&one, *d, &mut scratch).expect("square length");
                 assert!(e.is_finite(), "irradiance of finite coefficients: {e}");
+            }
+            if i == 0 {
+                let rows: [[f32; 3]; 3] = core::array::from_fn(|r| {
+                    core::array::from_fn(|c| f32_at(rest, 52 + 12 * r + 4 * c))
+                });
+                if let Ok(rot) = Rotation::new(rows) {
+                    check_rotation(&rot, &one, bands);
+                }
+                let axis = Vec3::new(f32_at(rest, 88), f32_at(rest, 92), f32_at(rest, 96));
+                if let Ok(rot) = Rotation::from_axis_angle(axis, f32_at(rest, 100)) {
+                    check_rotation(&rot, &one, bands);
+                }
             }
         }
     }

@@ -11,6 +11,7 @@
 pub mod cubemap;
 pub mod decompose;
 pub mod hdr;
+pub mod sh;
 pub mod sky;
 
 use std::fmt;

@@ -294,6 +294,54 @@ fn window_rows() -> Vec<(&'static str, f64)> {
         .collect()
 }
 
+/// Environment projection: (width, height, bands, ms) on the procedural sky, and the EXR
+/// files of `sky.exr` rendered back at 9 bands (radiance and irradiance).
+#[allow(clippy::type_complexity)]
+fn env_rows(
+    opts: &Options,
+) -> Result<(Vec<(usize, usize, usize, f64)>, Vec<(String, Vec<u8>)>), Box<dyn Error>> {
+    use crate::env::{Equirect, Sky, sh as esh};
+    let sky = Sky::default();
+    let mut rows = Vec::new();
+    for (w, h) in [(256usize, 128usize), (512, 256), (1024, 512)] {
+        let data = (0..h)
+            .flat_map(|y| (0..w).map(move |x| (x, y)))
+            .map(|(x, y)| {
+                let d = esh::texel_direction(x, y, w, h).as_dvec3();
+                sky.radiance(d).map(|v| v as f32)
+            })
+            .collect();
+        let env = Equirect::new(w, h, data)?;
+        for n in [3usize, 9, 30] {
+            let t = median_time(opts.repeats.min(3), || {
+                black_box(esh::project(&env, n).expect("bands"));
+            });
+            rows.push((w, h, n, t.as_secs_f64() * 1e3));
+        }
+    }
+    let mut files = Vec::new();
+    if let Ok(real) = Equirect::load(&crate::env::real_env_path()) {
+        let c = esh::project(&real, 9)?;
+        let (w, h) = (real.width().min(512), real.height().min(256));
+        for (name, img) in [
+            ("sh_sky_radiance_9.exr", esh::render_radiance(&c, w, h)?),
+            ("sh_sky_irradiance_9.exr", esh::render_irradiance(&c, w, h)?),
+        ] {
+            let buf = image::Rgb32FImage::from_raw(
+                w as u32,
+                h as u32,
+                img.data().iter().flatten().copied().collect(),
+            )
+            .ok_or("image size")?;
+            let mut bytes = std::io::Cursor::new(Vec::new());
+            image::DynamicImage::ImageRgb32F(buf)
+                .write_to(&mut bytes, image::ImageFormat::OpenExr)?;
+            files.push((name.to_string(), bytes.into_inner()));
+        }
+    }
+    Ok((rows, files))
+}
+
 /// The section.
 pub fn section(opts: &Options) -> Result<Section, Box<dyn Error>> {
     let rate = study::mul_add_rate();
@@ -303,6 +351,7 @@ pub fn section(opts: &Options) -> Result<Section, Box<dyn Error>> {
     let t1 = table1(opts);
     let brdf = brdf_rows();
     let windows = window_rows();
+    let (env, files) = env_rows(opts)?;
 
     let mut html = String::new();
     let mut summary = String::new();
@@ -433,7 +482,38 @@ pub fn section(opts: &Options) -> Result<Section, Box<dyn Error>> {
     }
     html.push_str("</table>");
 
+    writeln!(
+        html,
+        "<h3>Environment projection</h3><p>Exact texel integrals (separable: Gauss–Legendre per row, \
+         closed-form column integrals), rows in parallel on {} threads, the procedural sky. \
+         <code>sky.exr</code> rendered back at 9 bands: {}.</p>\
+         <table><tr><th>image</th><th>texels</th><th>bands</th><th>ms</th></tr>",
+        rayon::current_num_threads(),
+        files
+            .iter()
+            .map(|(n, _)| format!("<a href=\"{n}\">{n}</a>"))
+            .collect::<Vec<_>>()
+            .join(", ")
+    )?;
+    for (w, h, n, ms) in &env {
+        writeln!(
+            html,
+            "<tr><td>{w} × {h}</td><td>{}</td><td>{n}</td><td>{ms:.2}</td></tr>",
+            w * h
+        )?;
+    }
+    html.push_str("</table>");
+    if let Some((w, h, n, ms)) = env.last() {
+        writeln!(
+            summary,
+            "env projection: {w} × {h} onto {n} bands in {ms:.1} ms"
+        )?;
+    }
+
     let data = json!({
+        "env_projection": env.iter().map(|(w, h, n, ms)| json!({
+            "width": w, "height": h, "bands": n, "ms": ms,
+        })).collect::<Vec<_>>(),
         "mul_add_pairs_per_ns": rate,
         "eval": eval.iter().map(|r| json!({
             "bands": r.bands,
@@ -461,6 +541,6 @@ pub fn section(opts: &Options) -> Result<Section, Box<dyn Error>> {
         summary,
         html,
         data,
-        files: Vec::new(),
+        files,
     })
 }
