@@ -99,7 +99,8 @@ pub fn sphrs_set(bands: usize) -> sphrs::HarmonicsSet<f64, sphrs::RealSH> {
     sphrs::HarmonicsSet::new(bands.saturating_sub(1), sphrs::RealSH::Spherical)
 }
 
-/// Multiply–add pairs per nanosecond of this binary on this machine: eight independent
+/// Multiply–add pairs per nanosecond of this binary on this machine (median of five runs
+/// after a warm-up): eight independent
 /// `a = a·b + c` chains in `f64`, the instructions the SH recurrence compiles to (the build
 /// targets baseline x86-64, so a multiply and an add, not a fused multiply-add).
 pub fn mul_add_rate() -> f64 {
@@ -114,8 +115,7 @@ pub fn mul_add_rate() -> f64 {
         }
         black_box(a);
     };
-    run();
-    let (_, t) = timed(run);
+    let t = crate::report::timing::median_time(5, run);
     iters as f64 / (t.as_secs_f64() * 1e9)
 }
 

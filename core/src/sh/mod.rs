@@ -272,8 +272,9 @@ pub fn unit_direction(d: Vec3) -> DVec3 {
 /// per `m` (about 12 cycles of latency per step), so one chain at a time leaves the
 /// arithmetic units idle; the orders `m` and `m + 1` run in the same loop, their steps
 /// independent. Each value is computed by the same operations in the same order as one
-/// chain at a time, so the bits do not depend on the pairing (the SIMD twin runs one chain
-/// at a time and is tested bit for bit).
+/// chain at a time, so the bits do not depend on the pairing (the SIMD twin pairs the
+/// chains the same way over four directions and is tested bit for bit). Measured in the
+/// report's SH section: 1.3× faster than one chain at a time at 30 bands.
 #[inline(always)]
 fn fill(d: DVec3, bands: usize, out: &mut [f32]) {
     let out = &mut out[..bands * bands];

@@ -52,30 +52,57 @@ fn fill(u: [DVec3; 4], bands: usize, put: &mut impl FnMut(usize, f64x4)) {
         put(l * l + l, p);
         (p2, p1) = (p1, p);
     }
+    // m ≥ 1, two orders per pass (the scalar kernel's pairing: same operations per value).
+    let step = |l: usize, m: usize, q1: f64x4, q2: f64x4| {
+        let k = tri(l, m);
+        sp(A[k]) * (z * q1 - sp(B[k]) * r2 * q2)
+    };
     let (mut pmm, mut c, mut s) = (y00, sp(1.0), sp(0.0));
-    for m in 1..bands {
+    let mut m = 1;
+    while m < bands {
         pmm *= DIAG[m];
         (c, s) = (x * c - y * s, x * s + y * c);
-        let q = core::f64::consts::SQRT_2 * pmm;
-        let mut q2 = sp(q);
+        let (ca, sa) = (c, s);
+        let mut a2 = sp(core::f64::consts::SQRT_2 * pmm);
         let at = m * m + m;
-        put(at + m, q2 * c);
-        put(at - m, q2 * s);
+        put(at + m, a2 * ca);
+        put(at - m, a2 * sa);
         if m + 1 == bands {
             break;
         }
-        let mut q1 = sp(SUB[m]) * z * q2;
-        let at = at + 2 * m + 2;
-        put(at + m, q1 * c);
-        put(at - m, q1 * s);
-        for l in m + 2..bands {
-            let k = tri(l, m);
-            let q = sp(A[k]) * (z * q1 - sp(B[k]) * r2 * q2);
-            let at = l * l + l;
-            put(at + m, q * c);
-            put(at - m, q * s);
-            (q2, q1) = (q1, q);
+        let mut a1 = sp(SUB[m]) * z * a2;
+        let at = (m + 1) * (m + 1) + m + 1;
+        put(at + m, a1 * ca);
+        put(at - m, a1 * sa);
+        pmm *= DIAG[m + 1];
+        (c, s) = (x * c - y * s, x * s + y * c);
+        let (cb, sb) = (c, s);
+        let mut b2 = sp(core::f64::consts::SQRT_2 * pmm);
+        put(at + m + 1, b2 * cb);
+        put(at - m - 1, b2 * sb);
+        if m + 2 == bands {
+            break;
         }
+        let q = step(m + 2, m, a1, a2);
+        let at = (m + 2) * (m + 2) + m + 2;
+        put(at + m, q * ca);
+        put(at - m, q * sa);
+        (a2, a1) = (a1, q);
+        let mut b1 = sp(SUB[m + 1]) * z * b2;
+        put(at + m + 1, b1 * cb);
+        put(at - m - 1, b1 * sb);
+        for l in m + 3..bands {
+            let qa = step(l, m, a1, a2);
+            let qb = step(l, m + 1, b1, b2);
+            let at = l * l + l;
+            put(at + m, qa * ca);
+            put(at - m, qa * sa);
+            put(at + m + 1, qb * cb);
+            put(at - m - 1, qb * sb);
+            (a2, a1) = (a1, qa);
+            (b2, b1) = (b1, qb);
+        }
+        m += 2;
     }
 }
 
@@ -119,9 +146,13 @@ pub fn eval_slices(
             }
         }
         let mut put = |c: usize, v: f64x4| {
-            let a = v.to_array();
-            for k in 0..live {
-                out[c * len + i + k] = a[k] as f32;
+            let a = v.to_array().map(|x| x as f32);
+            let at = c * len + i;
+            if live == 4 {
+                // One 16-byte store per coefficient.
+                out[at..at + 4].copy_from_slice(&a);
+            } else {
+                out[at..at + live].copy_from_slice(&a[..live]);
             }
         };
         fill(u, bands, &mut put);
