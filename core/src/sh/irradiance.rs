@@ -23,11 +23,17 @@
 //! every band is finite and accurate (it decays like `l^(−5/2)`; pbrt and Filament stop or
 //! overflow at 18–50 bands). Then `E(n) = Σ_l A_l·Σ_m L_l^m·Y_l^m(n)`.
 //!
+//! **The closed forms of three bands.** [`irradiance_9`] is Ramamoorthi and Hanrahan's
+//! 4×4 quadratic form of the nine coefficients and [`irradiance_zonal`] the HVL paper's
+//! 2×2 form (appendix B) for radiance symmetric about an axis; both are derived again from
+//! `A_l` and the polynomial forms of bands 0–2 and tested equal to [`irradiance`].
+//!
 //! **Accuracy** (tests below): the factors to 1 ulp of `f32` against the closed form in
 //! `f64`; the irradiance against the `f64` quadrature of `∫ L·max(n·ω, 0) dω` for
 //! band-limited radiance, to `1e-6` of `Σ|A_l|·|L_l^m|`-weighted sums (the evaluation's
 //! error).
 
+use crate::math;
 use crate::sh::{bands_of, eval_into};
 use crate::{Error, Vec3};
 
@@ -77,6 +83,61 @@ pub fn irradiance(radiance: &[f32], normal: Vec3, scratch: &mut [f32]) -> Result
 #[inline]
 pub fn lambert_radiance(albedo: f32, irradiance: f32) -> f32 {
     albedo * irradiance * core::f32::consts::FRAC_1_PI
+}
+
+/// The classic 9-coefficient form (Ramamoorthi and Hanrahan 2001, eq. 12–13): for 3-band
+/// radiance, `E(n) = nᵀ·M·n` with `n = (x, y, z, 1)` and the symmetric 4×4 matrix
+///
+/// ```text
+///   ( c₁L₂²    c₁L₂⁻²   c₁L₂¹    c₂L₁¹ )
+///   ( c₁L₂⁻²  −c₁L₂²    c₁L₂⁻¹   c₂L₁⁻¹ )
+///   ( c₁L₂¹    c₁L₂⁻¹   c₃L₂⁰    c₂L₁⁰ )
+///   ( c₂L₁¹    c₂L₁⁻¹   c₂L₁⁰    c₄L₀⁰ − c₅L₂⁰ )
+/// ```
+///
+/// in their basis, where `Y₁^{±1}` and `Y₂^{±1}` carry the opposite sign of this crate's
+/// (no Condon–Shortley phase): those four coefficients enter negated here. Derived, not
+/// copied: `E = Σ A_l·L_l^m·Y_l^m(n)` with the polynomial forms of bands 0–2 gives
+/// `c₁ = A₂·√(15/π)/4`, `c₂ = A₁·√(3/(4π))/2` (the off-diagonal entries count twice in
+/// `nᵀMn`), `c₃ = 3·A₂·√(5/π)/4`, `c₄ = A₀/√(4π)`,
+/// `c₅ = A₂·√(5/π)/4` (0.429043, 0.511663, 0.743124, 0.886227, 0.247708; the published
+/// `c₃ = 0.743125` is 1.1e-6 above the exact value), computed here in
+/// `f64` from [`clamped_cosine`]. Equal to [`irradiance`] at 3 bands (tested).
+pub fn irradiance_9(radiance: &[f32; 9], normal: Vec3) -> f32 {
+    let n = crate::sh::unit_direction(normal);
+    let pi = core::f64::consts::PI;
+    let (a0, a1, a2) = (clamped_cosine(0), clamped_cosine(1), clamped_cosine(2));
+    let c1 = a2 * math::sqrt64(15.0 / pi) / 4.0;
+    let c2 = a1 * math::sqrt64(3.0 / (4.0 * pi)) / 2.0;
+    let c3 = 3.0 * a2 * math::sqrt64(5.0 / pi) / 4.0;
+    let c4 = a0 / math::sqrt64(4.0 * pi);
+    let c5 = a2 * math::sqrt64(5.0 / pi) / 4.0;
+    let l = radiance.map(f64::from);
+    // Their basis: flip the sign of m = ±1 (indices 1, 3, 5, 7).
+    let (l00, l1m, l10, l1p) = (l[0], -l[1], l[2], -l[3]);
+    let (l2mm, l2m, l20, l2p, l2pp) = (l[4], -l[5], l[6], -l[7], l[8]);
+    let (x, y, z) = (n.x, n.y, n.z);
+    let e = c1 * l2pp * (x * x - y * y) + c3 * l20 * z * z + c4 * l00 - c5 * l20
+        + 2.0 * c1 * (l2mm * x * y + l2p * x * z + l2m * y * z)
+        + 2.0 * c2 * (l1p * x + l1m * y + l10 * z);
+    e as f32
+}
+
+/// The HVL paper's 2×2 form (appendix B) for radiance symmetric about an axis `ω_l` with
+/// zonal coefficients `L_0, L_1, L_2` (about that axis): with `z = ω_l·n`,
+/// `E = (z, 1)·M·(z, 1)ᵀ`, `M = ((c₃L₂, c₂L₁), (c₂L₁, c₄L₀ − c₅L₂))`, i.e.
+/// `E(z) = c₃L₂z² + 2c₂L₁z + c₄L₀ − c₅L₂` — the 4×4 form of [`irradiance_9`] with the axis
+/// along `z` (only `m = 0` survives). Derived constants as there.
+pub fn irradiance_zonal(zonal: [f32; 3], axis: Vec3, normal: Vec3) -> f32 {
+    let z = crate::sh::unit_direction(axis).dot(crate::sh::unit_direction(normal));
+    let pi = core::f64::consts::PI;
+    let (a0, a1, a2) = (clamped_cosine(0), clamped_cosine(1), clamped_cosine(2));
+    let c2 = a1 * math::sqrt64(3.0 / (4.0 * pi)) / 2.0;
+    let c3 = 3.0 * a2 * math::sqrt64(5.0 / pi) / 4.0;
+    let c4 = a0 / math::sqrt64(4.0 * pi);
+    let c5 = a2 * math::sqrt64(5.0 / pi) / 4.0;
+    let [l0, l1, l2] = zonal.map(f64::from);
+    (c3 * l2 * z * z + 2.0 * c2 * l1 * z + c4 * l0 - c5 * l2) as f32
 }
 
 #[cfg(all(test, feature = "alloc"))]
@@ -142,5 +203,45 @@ mod tests {
         assert!(irradiance(&[0.0; 5], Vec3::Z, &mut scratch).is_err());
         assert!(irradiance(&[0.0; 16], Vec3::Z, &mut scratch[..8]).is_err());
         assert_eq!(irradiance(&[], Vec3::Z, &mut []).unwrap(), 0.0);
+    }
+
+    #[test]
+    fn the_nine_coefficient_and_two_by_two_forms_equal_the_general_one() {
+        let mut s = 11u64;
+        let mut r = || {
+            s = s
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            ((s >> 40) as f32 / (1u64 << 24) as f32) * 2.0 - 1.0
+        };
+        let mut scratch = [0.0f32; 9];
+        for _ in 0..200 {
+            let c: [f32; 9] = core::array::from_fn(|_| r());
+            let n = Vec3::new(r(), r(), r() + 0.01);
+            let want = irradiance(&c, n, &mut scratch).unwrap();
+            let got = irradiance_9(&c, n);
+            assert!((got - want).abs() < 1e-5, "{got} vs {want}");
+            // A zonal function about `axis`: its full coefficients by eq. 15.
+            let axis = Vec3::new(r(), r(), r() + 0.01);
+            let zonal = [r(), r(), r()];
+            let mut y = [0.0f32; 9];
+            crate::sh::eval_into(axis, 3, &mut y).unwrap();
+            let full: [f32; 9] = core::array::from_fn(|i| {
+                let l = (i as f32).sqrt() as usize;
+                (f64::from(y[i]) * super::super::convolve::funk_hecke(l) * f64::from(zonal[l]))
+                    as f32
+            });
+            let want = irradiance(&full, n, &mut scratch).unwrap();
+            let got = irradiance_zonal(zonal, axis, n);
+            assert!((got - want).abs() < 1e-5, "zonal: {got} vs {want}");
+        }
+        // The published constants.
+        let pi = core::f64::consts::PI;
+        let c1 = clamped_cosine(2) * (15.0 / pi).sqrt() / 4.0;
+        assert!((c1 - 0.429043).abs() < 1e-6);
+        assert!((clamped_cosine(1) * (3.0 / (4.0 * pi)).sqrt() / 2.0 - 0.511664).abs() < 1e-6);
+        assert!((3.0 * clamped_cosine(2) * (5.0 / pi).sqrt() / 4.0 - 0.743125).abs() < 1.5e-6);
+        assert!((clamped_cosine(0) / (4.0 * pi).sqrt() - 0.886227).abs() < 1e-6);
+        assert!((clamped_cosine(2) * (5.0 / pi).sqrt() / 4.0 - 0.247708).abs() < 1e-6);
     }
 }
