@@ -58,7 +58,7 @@ fn towards(point: Vec3, light: Vec3) -> Result<(Vec3, f32), Error> {
             what: "light − point",
         });
     }
-    Ok(((v / d2.sqrt()).as_vec3(), d2 as f32))
+    Ok(((v / crate::math::sqrt64(d2)).as_vec3(), d2 as f32))
 }
 
 /// A point light of intensity `intensity` (W/sr, per channel) at `position`, seen from

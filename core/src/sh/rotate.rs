@@ -72,7 +72,7 @@
 //!   decomposition with the fixed 90° blocks).
 
 use crate::math;
-use crate::sh::{bands_of, check_shape};
+use crate::sh::check_shape;
 use crate::{Error, Vec3};
 use glam::{DMat3, DVec3};
 
@@ -560,7 +560,7 @@ impl Rotator {
     /// the table's). Errors: a length that is not a square, more bands than the table, a
     /// short `out`.
     pub fn rotate(&self, rot: &Rotation, input: &[f32], out: &mut [f32]) -> Result<(), Error> {
-        let n = bands_of(input.len())?;
+        let n = crate::sh::bands_of(input.len())?;
         if n > self.bands {
             return Err(Error::OutOfRange {
                 what: "SH bands of the rotated vector",
@@ -576,6 +576,7 @@ impl Rotator {
 #[cfg(all(test, feature = "alloc"))]
 mod tests {
     use super::*;
+    use crate::sh::bands_of;
     use alloc::vec;
     use alloc::vec::Vec;
     extern crate std;
