@@ -228,8 +228,9 @@ mod tests {
             crate::sh::eval_into(axis, 3, &mut y).unwrap();
             let full: [f32; 9] = core::array::from_fn(|i| {
                 let l = (i as f32).sqrt() as usize;
-                (f64::from(y[i]) * super::super::convolve::funk_hecke(l) * f64::from(zonal[l]))
-                    as f32
+                (f64::from(y[i])
+                    * (4.0 * core::f64::consts::PI / (2 * l + 1) as f64).sqrt()
+                    * f64::from(zonal[l])) as f32
             });
             let want = irradiance(&full, n, &mut scratch).unwrap();
             let got = irradiance_zonal(zonal, axis, n);
