@@ -3,6 +3,9 @@
 //! bit-identical) and, as the baseline of the same run, a plain `f64` evaluation (the
 //! reference's factorial normalisation, unnormalised Legendre recurrence and `cos(mφ)`).
 //!
+//! Also rotation per vector (ZXZXZ, the built operator's application and build) at 3, 5, 10
+//! and 30 bands, and one HVL contribution and one cap projection at 3, 5 and 9 bands.
+//!
 //! `cargo bench -p steradian-benches --bench sh`
 
 use std::hint::black_box;
@@ -59,5 +62,94 @@ fn eval(c: &mut Criterion) {
     g.finish();
 }
 
-criterion_group!(benches, eval);
+/// Rotation per vector: the ZXZXZ path and the built operator's application, at 3, 5, 10
+/// and 30 bands, and the operator's build (what a batch sharing one rotation pays once).
+fn rotation(c: &mut Criterion) {
+    use steradian_core::sh::rotate::{Operator, Rotation, Rotator};
+    let rot = Rotation::from_axis_angle(Vec3::new(0.3, -0.5, 0.8), 1.1).unwrap();
+    let mut g = c.benchmark_group("sh-rotate");
+    for bands in [3usize, 5, 10, 30] {
+        let input: Vec<f32> = (0..bands * bands)
+            .map(|i| ((i * 7919) % 13) as f32 - 6.0)
+            .collect();
+        let mut out = vec![0.0f32; bands * bands];
+        let rz = Rotator::new(bands).unwrap();
+        g.throughput(Throughput::Elements(1));
+        g.bench_with_input(BenchmarkId::new("zxzxz", bands), &bands, |b, _| {
+            b.iter(|| rz.rotate(&rot, black_box(&input), &mut out).unwrap())
+        });
+        let op = Operator::new(&rot, bands).unwrap();
+        g.bench_with_input(BenchmarkId::new("operator apply", bands), &bands, |b, _| {
+            b.iter(|| op.apply(black_box(&input), &mut out).unwrap())
+        });
+        g.bench_with_input(
+            BenchmarkId::new("operator build", bands),
+            &bands,
+            |b, &n| b.iter(|| black_box(Operator::new(&rot, n).unwrap())),
+        );
+    }
+    g.finish();
+}
+
+/// One HVL's contribution (cap projection, rotation into the receiver's frame by
+/// evaluation, two dot products) at 3, 5 and 9 bands, and the cap projection alone.
+fn hvl(c: &mut Criterion) {
+    use steradian_core::sh::{brdf, cap, hvl};
+    let table = brdf::phong();
+    let h = hvl::Hvl::new(
+        Vec3::new(-0.6, 0.1, 0.8),
+        -Vec3::Z,
+        Vec3::new(0.3, 0.0, -1.0),
+        0.15,
+        2.0,
+    )
+    .unwrap();
+    let em = hvl::lambert_emission(0.8);
+    let wo = Vec3::new(0.6, 0.0, 0.8);
+    let frame = brdf::view_frame(Vec3::Z, wo).unwrap();
+    let mut g = c.benchmark_group("sh-hvl");
+    g.throughput(Throughput::Elements(1));
+    for bands in [3usize, 5, 9] {
+        let mut coeffs = vec![0.0f32; bands * bands];
+        table
+            .lookup_into(brdf::Part::WithCosine, 0.64, bands, &mut coeffs)
+            .unwrap();
+        let rx = hvl::Receiver {
+            point: Vec3::ZERO,
+            frame,
+            coeffs: &coeffs,
+        };
+        let mut scratch = vec![0.0f32; bands * bands];
+        g.bench_with_input(BenchmarkId::new("contribution", bands), &bands, |b, _| {
+            b.iter(|| {
+                hvl::contribution(
+                    black_box(&h),
+                    &em,
+                    &rx,
+                    hvl::Horizon::Smoothstep,
+                    &mut scratch,
+                )
+                .unwrap()
+            })
+        });
+        g.bench_with_input(
+            BenchmarkId::new("cap projection", bands),
+            &bands,
+            |b, &n| {
+                b.iter(|| {
+                    cap::coefficients_into(
+                        black_box(Vec3::new(0.3, 0.2, 0.9)),
+                        0.2,
+                        n,
+                        &mut scratch,
+                    )
+                    .unwrap()
+                })
+            },
+        );
+    }
+    g.finish();
+}
+
+criterion_group!(benches, eval, rotation, hvl);
 criterion_main!(benches);
