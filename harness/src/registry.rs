@@ -345,10 +345,11 @@ pub const KERNELS: &[KernelSpec] = &[
         eval: Piece::At(handlers::sh_eval),
         scalar: "steradian_core::sh::eval_into",
         simd: Piece::At("steradian_simd::sh::eval_slices"),
-        wgsl: Piece::Without(
-            "not written yet: WGSL has no f64, and the f32 recurrence misses the 1e-5 bound \
-             beyond 17 bands (steradian_core::sh module docs)",
-        ),
+        wgsl: Piece::At(WgslTwin {
+            source: wgsl::SH_EVAL,
+            tolerance: "steradian_core::wgsl::SH_EVAL_TOL",
+            table: Some("f32"),
+        }),
         reference: Piece::At("steradian_reference::sh::eval"),
         bound: Piece::At(Bound {
             metric: "abs per band",

@@ -15,6 +15,7 @@ mod product_gpu;
 mod properties;
 mod sat;
 mod sh;
+mod sh_gpu;
 mod shade;
 mod shade_moments_gpu;
 mod vdt;

@@ -170,6 +170,24 @@ pub const VDT_QUERY: &str = concat!(
 /// by the half-side). Lavapipe: bit-identical (harness test `tests/vdt_gpu.rs`).
 pub const VDT_QUERY_TOL: f32 = 2.0e-6;
 
+/// All `bands²` real SH at a direction (`sh::eval_into`) in `f32`, for `bands ≤ 16`
+/// ([`SH_EVAL_MAX_BANDS`]). Input columns `[x, y, z]`, output columns `l² + l + m`. Binding 3
+/// is one `f32`: the band count. Not in [`ALL`]: run it with the harness's custom kernels.
+/// WGSL has no `f64`, so unlike the scalar kernel the recurrence runs in `f32` (its rounding
+/// grows like `l²`: `1e-5` is reached near band 17), and its coefficients come from `sqrt`
+/// of the same rationals on the GPU. Tolerance: [`SH_EVAL_TOL`].
+pub const SH_EVAL: &str = concat!(
+    include_str!("batch.wgsl"),
+    include_str!("../sh/sh_eval.wgsl")
+);
+/// Largest band count of [`SH_EVAL`].
+pub const SH_EVAL_MAX_BANDS: usize = 16;
+/// Absolute difference allowed between [`SH_EVAL`] and `sh::eval_into` per value, for up
+/// to [`SH_EVAL_MAX_BANDS`] bands (the values are at most `√((2l+1)/(2π))` ≈ 2.2 in size).
+/// Lavapipe: `1.7e-6` at 9 bands, `7.7e-6` at 16 (harness test `tests/sh_gpu.rs`, which
+/// prints them).
+pub const SH_EVAL_TOL: f32 = 1.0e-5;
+
 /// RSL shading of one point per invocation (`shade::shade` with an isotropic BRDF SAT and
 /// one VDT per point). Input columns `[tx, ty, tz, bx, by, bz, nx, ny, nz, wox, woy, woz,
 /// vdt_index]` (frame axes, world view, which VDT), output `[r, g, b]`. Binding 3 is one
@@ -282,8 +300,9 @@ pub const ALL: [(&str, &str); 5] = [
 
 /// The kernels outside [`ALL`], with a caller-supplied table at binding 3 (run them with
 /// the harness's custom kernels), as `(name, source, element type of the table)`.
-pub const CUSTOM: [(&str, &str, &str); 5] = [
+pub const CUSTOM: [(&str, &str, &str); 6] = [
     ("lobe-product", LOBE_PRODUCT, "f32"),
+    ("sh-eval", SH_EVAL, "f32"),
     ("sat-box", SAT_BOX, "u32"),
     ("vdt-box", VDT_QUERY, "f32"),
     ("shade", SHADE, "u32"),
