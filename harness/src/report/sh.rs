@@ -17,8 +17,11 @@ use steradian_core::sh::{self, rotate, window::Window};
 use super::Options;
 use super::section::Section;
 use super::timing::{median_time, median_times_in_turns, ns_per};
+use crate::backend::gpu::{Custom, Gpu, try_gpu};
 use crate::generate::brdf_sh;
+use crate::kernels::Columns;
 use crate::sh as study;
+use steradian_core::wgsl;
 
 const SEED: u64 = 0x0005_4a11;
 /// Band counts of the evaluation table.
@@ -35,10 +38,14 @@ struct EvalRow {
     bands: usize,
     ns: [f64; 4],
     identity: [f64; 4],
+    /// wgpu, upload and read-back included (bands ≤ `wgsl::SH_EVAL_MAX_BANDS`).
+    gpu_ns: Option<f64>,
 }
 
-fn eval_rows(opts: &Options) -> Vec<EvalRow> {
+fn eval_rows(opts: &Options, gpu: &mut Option<Gpu>) -> Vec<EvalRow> {
     let dirs = study::directions(opts.scaled(4096).max(64), SEED);
+    let rows: Vec<[f32; 3]> = dirs.clone();
+    let columns = Columns::from_rows(&rows);
     EVAL_BANDS
         .iter()
         .map(|&n| {
@@ -113,10 +120,28 @@ fn eval_rows(opts: &Options) -> Vec<EvalRow> {
                     *a = a.max(b);
                 }
             }
+            let gpu_ns = match gpu.as_mut() {
+                Some(g) if n <= wgsl::SH_EVAL_MAX_BANDS => {
+                    let table = [n as f32];
+                    let custom = Custom {
+                        label: "sh-eval",
+                        source: wgsl::SH_EVAL,
+                        table: Some(&table),
+                    };
+                    let mut out = Columns::zeros(nn, dirs.len());
+                    let t = median_time(opts.repeats.min(5), || {
+                        g.run_custom(&custom, &columns, &mut out)
+                            .expect("SH kernel runs");
+                    });
+                    Some(ns_per(dirs.len(), t))
+                }
+                _ => None,
+            };
             EvalRow {
                 bands: n,
                 ns,
                 identity,
+                gpu_ns,
             }
         })
         .collect()
@@ -345,7 +370,19 @@ fn env_rows(
 /// The section.
 pub fn section(opts: &Options) -> Result<Section, Box<dyn Error>> {
     let rate = study::mul_add_rate();
-    let eval = eval_rows(opts);
+    let mut gpu_note = "not requested".to_string();
+    let mut gpu = None;
+    if opts.gpu {
+        match try_gpu() {
+            Ok(g) => {
+                gpu_note = g.adapter_info();
+                gpu = Some(g);
+            }
+            Err(e) => gpu_note = format!("no adapter: {e}"),
+        }
+    }
+    let eval = eval_rows(opts, &mut gpu);
+    drop(gpu);
     let rot = rotate_rows(opts);
     let caps = cap_rows(opts);
     let t1 = table1(opts);
@@ -365,7 +402,12 @@ pub fn section(opts: &Options) -> Result<Section, Box<dyn Error>> {
          coefficient the recurrence could reach {:.2} coefficients/ns.</p>",
         rate / 3.0
     )?;
-    html.push_str("<table><tr><th>bands</th><th>scalar</th><th>SIMD</th><th>plain f64</th><th>sphrs</th><th>scalar / plain</th><th>SIMD / scalar</th><th>coeff/ns (of op-count limit)</th><th>identity error: ours, plain, sphrs</th></tr>");
+    writeln!(
+        html,
+        "<p>wgpu: {gpu_note} (f32, up to {} bands, upload and read-back included).</p>",
+        wgsl::SH_EVAL_MAX_BANDS
+    )?;
+    html.push_str("<table><tr><th>bands</th><th>scalar</th><th>SIMD</th><th>wgpu</th><th>plain f64</th><th>sphrs</th><th>scalar / plain</th><th>SIMD / scalar</th><th>coeff/ns (of op-count limit)</th><th>identity error: ours, plain, sphrs</th></tr>");
     for r in &eval {
         let cpn = (r.bands * r.bands) as f64 / r.ns[0];
         writeln!(
@@ -511,13 +553,14 @@ pub fn section(opts: &Options) -> Result<Section, Box<dyn Error>> {
     }
 
     let data = json!({
+        "gpu": gpu_note,
         "env_projection": env.iter().map(|(w, h, n, ms)| json!({
             "width": w, "height": h, "bands": n, "ms": ms,
         })).collect::<Vec<_>>(),
         "mul_add_pairs_per_ns": rate,
         "eval": eval.iter().map(|r| json!({
             "bands": r.bands,
-            "ns_per_dir": {"scalar": r.ns[0], "simd": r.ns[1], "plain_f64": r.ns[2], "sphrs": r.ns[3]},
+            "ns_per_dir": {"scalar": r.ns[0], "simd": r.ns[1], "wgpu": r.gpu_ns, "plain_f64": r.ns[2], "sphrs": r.ns[3]},
             "identity_error": {"ours": r.identity[0], "plain_f64": r.identity[2], "sphrs": r.identity[3]},
         })).collect::<Vec<_>>(),
         "rotate": rot.iter().map(|r| json!({
