@@ -428,10 +428,11 @@ pub fn section(opts: &Options) -> Result<Section, Box<dyn Error>> {
         )?;
         writeln!(
             summary,
-            "sh-eval {:2} bands: scalar {:.1} ns, SIMD {:.1} ns, plain f64 {:.1} ns ({:.2}× ours), sphrs {:.1} ns (identity error {:.1e})",
+            "sh-eval {:2} bands: scalar {:.1} ns, SIMD {:.1} ns, wgpu {}, plain f64 {:.1} ns ({:.2}× ours), sphrs {:.1} ns (identity error {:.1e})",
             r.bands,
             r.ns[0],
             r.ns[1],
+            r.gpu_ns.map_or("—".to_string(), |g| format!("{g:.1} ns")),
             r.ns[2],
             r.ns[2] / r.ns[0],
             r.ns[3],
