@@ -402,7 +402,8 @@ pub const KERNELS: &[KernelSpec] = &[
         eval: Piece::At(handlers::sh_rotate),
         scalar: "steradian_core::sh::rotate::rotate_zxzxz",
         simd: Piece::Without(
-            "not written yet: the built operator applied to 8 vectors per lane set",
+            "the ZXZXZ path has none; the built operator's twin (8 vectors per pass, \
+             bit-identical) is steradian_simd::sh::rotate::apply_operator_slices",
         ),
         wgsl: Piece::Without("not written yet"),
         reference: Piece::At("steradian_reference::sh::rotate"),

@@ -97,3 +97,85 @@ fn bad_shapes_are_errors() {
     let mut short = vec![[0.0f32; 4]; 3];
     assert!(eval_x4([Vec3::Z; 4], 2, &mut short).is_err());
 }
+
+/// `apply_operator_slices` on `vectors` (each `bands²` long, one after another) against the
+/// scalar `apply_operator`, bit for bit, every coefficient of every vector.
+fn check_rotation(op: &[f32], bands: usize, vectors: &[Vec<f32>]) {
+    let nn = bands * bands;
+    let input: Vec<f32> = vectors.concat();
+    let mut out = vec![0.0f32; input.len()];
+    steradian_simd::sh::rotate::apply_operator_slices(op, bands, &input, &mut out)
+        .expect("valid shapes");
+    let mut want = vec![0.0f32; nn];
+    for (v, x) in vectors.iter().enumerate() {
+        sh::rotate::apply_operator(op, bands, x, &mut want).expect("valid shapes");
+        for (k, w) in want.iter().enumerate() {
+            let got = out[v * nn + k];
+            assert!(
+                same(got, *w),
+                "bands {bands} vector {v} coefficient {k}: {got} vs {w}"
+            );
+        }
+    }
+}
+
+#[test]
+fn rotation_operator_lanes_equal_the_scalar_kernel() {
+    let mut rng = Rng(0x0707);
+    let rot = sh::rotate::Rotation::from_axis_angle(Vec3::new(0.3, -0.5, 0.8), 1.1).unwrap();
+    for bands in [0usize, 1, 2, 5, 12, 30] {
+        let op = sh::rotate::Operator::new(&rot, bands).unwrap();
+        let nn = bands * bands;
+        for &len in &LENGTHS {
+            let vectors: Vec<Vec<f32>> = (0..len.min(40))
+                .map(|_| (0..nn).map(|_| rng.range(-2.0, 2.0)).collect())
+                .collect();
+            check_rotation(op.blocks(), bands, &vectors);
+        }
+        // Special values in one coefficient of one vector, in every lane position: the
+        // other lanes are untouched and the lane itself matches the scalar kernel.
+        if nn > 0 {
+            let base: Vec<f32> = (0..nn).map(|k| (k as f32 * 0.37).sin()).collect();
+            for &sp in SPECIALS.iter() {
+                let mut odd = base.clone();
+                odd[nn / 2] = sp;
+                // The odd vector in every lane position (0..8 ordinary ones in front).
+                for shift in 0..8 {
+                    let mut rows = vec![base.clone(); shift];
+                    rows.push(odd.clone());
+                    check_rotation(op.blocks(), bands, &rows);
+                }
+            }
+        }
+    }
+    // Shapes: not a whole number of vectors, out of another length, a short operator.
+    let op = sh::rotate::Operator::new(&rot, 3).unwrap();
+    let mut out = vec![0.0f32; 18];
+    assert!(
+        steradian_simd::sh::rotate::apply_operator_slices(
+            op.blocks(),
+            3,
+            &[0.0; 17],
+            &mut out[..17]
+        )
+        .is_err()
+    );
+    assert!(
+        steradian_simd::sh::rotate::apply_operator_slices(
+            op.blocks(),
+            3,
+            &[0.0; 18],
+            &mut out[..9]
+        )
+        .is_err()
+    );
+    assert!(
+        steradian_simd::sh::rotate::apply_operator_slices(
+            &op.blocks()[..10],
+            3,
+            &[0.0; 18],
+            &mut out
+        )
+        .is_err()
+    );
+}

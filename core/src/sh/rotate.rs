@@ -394,8 +394,12 @@ pub fn apply_operator(
         let block = &op[operator_len(l)..operator_len(l + 1)];
         let x = &input[l * l..l * l + w];
         for (i, o) in out[l * l..l * l + w].iter_mut().enumerate() {
-            let row = &block[i * w..i * w + w];
-            *o = row.iter().zip(x).map(|(a, b)| a * b).sum();
+            // Left to right from +0: the order the SIMD twin repeats on each lane.
+            let mut acc = 0.0f32;
+            for (a, b) in block[i * w..i * w + w].iter().zip(x) {
+                acc += a * b;
+            }
+            *o = acc;
         }
     }
     Ok(())

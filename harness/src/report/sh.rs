@@ -152,6 +152,7 @@ struct RotateRow {
     zxzxz_ns: f64,
     build_ns: f64,
     apply_ns: f64,
+    simd_apply_ns: f64,
 }
 
 fn rotate_rows(opts: &Options) -> Vec<RotateRow> {
@@ -179,11 +180,24 @@ fn rotate_rows(opts: &Options) -> Vec<RotateRow> {
                 }
                 black_box(&out);
             });
+            let many: Vec<f32> = (0..vectors).flat_map(|_| input.iter().copied()).collect();
+            let mut many_out = vec![0.0f32; many.len()];
+            let simd = median_time(opts.repeats, || {
+                steradian_simd::sh::rotate::apply_operator_slices(
+                    op.blocks(),
+                    n,
+                    black_box(&many),
+                    &mut many_out,
+                )
+                .expect("shape");
+                black_box(&many_out);
+            });
             RotateRow {
                 bands: n,
                 zxzxz_ns: ns_per(vectors, zx),
                 build_ns: build.as_secs_f64() * 1e9,
                 apply_ns: ns_per(vectors, apply),
+                simd_apply_ns: ns_per(vectors, simd),
             }
         })
         .collect()
@@ -441,16 +455,17 @@ pub fn section(opts: &Options) -> Result<Section, Box<dyn Error>> {
     }
     html.push_str("</table>");
 
-    html.push_str("<h3>Rotation</h3><table><tr><th>bands</th><th>ZXZXZ per vector (ns)</th><th>operator build (ns)</th><th>operator apply per vector (ns)</th><th>vectors to break even</th></tr>");
+    html.push_str("<h3>Rotation</h3><table><tr><th>bands</th><th>ZXZXZ per vector (ns)</th><th>operator build (ns)</th><th>operator apply per vector (ns)</th><th>SIMD operator apply per vector (ns)</th><th>vectors to break even</th></tr>");
     for r in &rot {
         let even = r.build_ns / (r.zxzxz_ns - r.apply_ns).max(1e-9);
         writeln!(
             html,
-            "<tr><td>{}</td><td>{:.0}</td><td>{:.0}</td><td>{:.0}</td><td>{}</td></tr>",
+            "<tr><td>{}</td><td>{:.0}</td><td>{:.0}</td><td>{:.0}</td><td>{:.0}</td><td>{}</td></tr>",
             r.bands,
             r.zxzxz_ns,
             r.build_ns,
             r.apply_ns,
+            r.simd_apply_ns,
             if r.zxzxz_ns > r.apply_ns {
                 format!("{even:.1}")
             } else {
@@ -566,7 +581,7 @@ pub fn section(opts: &Options) -> Result<Section, Box<dyn Error>> {
         })).collect::<Vec<_>>(),
         "rotate": rot.iter().map(|r| json!({
             "bands": r.bands, "zxzxz_ns": r.zxzxz_ns, "operator_build_ns": r.build_ns,
-            "operator_apply_ns": r.apply_ns,
+            "operator_apply_ns": r.apply_ns, "simd_operator_apply_ns": r.simd_apply_ns,
         })).collect::<Vec<_>>(),
         "cap_ns": caps.iter().map(|(n, ns)| json!({"bands": n, "ns": ns})).collect::<Vec<_>>(),
         "hvl_table1": t1.rows.iter().map(|(m, n, us, e)| json!({

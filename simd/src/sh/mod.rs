@@ -11,6 +11,8 @@
 //!
 //! Those of `steradian_core::sh` (the HVL paper, eq. 7–8).
 
+pub mod rotate;
+
 use glam::DVec3;
 use steradian_core::sh::{A, B, DIAG, SUB, Y00_F64, check_shape, tri, unit_direction};
 use steradian_core::{Error, Vec3};
