@@ -7,7 +7,7 @@ use std::hint::black_box;
 use std::time::Duration;
 
 use steradian_core::Vec3;
-use steradian_core::sh::{self, brdf, hvl};
+use steradian_core::sh::{brdf, hvl};
 use steradian_reference::lobe::brdf::Model;
 use steradian_reference::sh::hvl as href;
 
@@ -305,6 +305,3 @@ pub fn directions(count: usize, seed: u64) -> Vec<[f32; 3]> {
     let mut rng = crate::rng::Rng::new(seed);
     (0..count).map(|_| rng.sphere().map(|c| c as f32)).collect()
 }
-
-/// `sh::MAX_BANDS`, re-exported for the report's bounds.
-pub const MAX_BANDS: usize = sh::MAX_BANDS;

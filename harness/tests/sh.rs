@@ -26,6 +26,14 @@ fn direction() -> impl Strategy<Value = [f32; 3]> {
         .prop_map(|(x, y, z, s)| [x * s, y * s, z * s])
 }
 
+/// `bands²` coefficients uniform in `[−1, 1)` from `seed`.
+fn coefficients(bands: usize, seed: u64) -> Vec<f32> {
+    let mut rng = steradian_harness::rng::Rng::new(seed);
+    (0..bands * bands)
+        .map(|_| rng.range(-1.0, 1.0) as f32)
+        .collect()
+}
+
 fn unit64(d: [f32; 3]) -> [f64; 3] {
     let d = d.map(f64::from);
     let n = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
@@ -95,13 +103,7 @@ proptest! {
         axis in direction(), angle in -7.0f32..7.0, bands in 1usize..=12,
         seed in any::<u64>(),
     ) {
-        let mut s = seed;
-        let c: Vec<f32> = (0..bands * bands)
-            .map(|_| {
-                s = s.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
-                ((s >> 40) as f32 / (1u64 << 24) as f32) * 2.0 - 1.0
-            })
-            .collect();
+        let c = coefficients(bands, seed);
         let r = rotation(axis, angle);
         let v = eval_line("sh-rotate", &json!({"coeffs": c, "rotation": r}).to_string()).unwrap();
         let got = numbers(&v, "coeffs");
@@ -139,13 +141,7 @@ proptest! {
 
     #[test]
     fn sh_irradiance_within_bound(n in direction(), bands in 1usize..=6, seed in any::<u64>()) {
-        let mut s = seed;
-        let c: Vec<f32> = (0..bands * bands)
-            .map(|_| {
-                s = s.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
-                ((s >> 40) as f32 / (1u64 << 24) as f32) * 2.0 - 1.0
-            })
-            .collect();
+        let c = coefficients(bands, seed);
         let v = eval_line("sh-irradiance", &json!({"coeffs": c, "normal": n}).to_string()).unwrap();
         let got = v["irradiance"].as_f64().unwrap();
         let want = reference::irradiance(&c.iter().map(|&x| f64::from(x)).collect::<Vec<_>>(), unit64(n));
@@ -200,4 +196,29 @@ fn bad_lines_of_the_sh_kernels() {
     // Within the tolerance: accepted.
     let ok = r#"{"coeffs": [1, 0, 0, 0], "rotation": [[1,0,0],[0,1,0],[0,0,1.000004]]}"#;
     assert!(eval_line("sh-rotate", ok).is_ok());
+}
+
+#[test]
+fn the_peers_of_the_report_against_the_addition_theorem() {
+    // The report's plain f64 evaluation is a correct baseline (it matches the reference), and
+    // `sphrs` 0.2.2 breaks the addition theorem from 20 bands on (README).
+    use steradian_harness::sh as study;
+    for d in study::directions(16, 3) {
+        let d = d.map(f64::from);
+        for n in [3usize, 10, 20, 30] {
+            let mut plain = vec![0.0; n * n];
+            study::plain_eval(d, n, &study::plain_norms(n), &mut plain);
+            let want = reference::eval(d, n);
+            for (a, b) in plain.iter().zip(&want) {
+                assert!((a - b).abs() < 1e-12, "{n}: {a} vs {b}");
+            }
+            let peer = study::sphrs_eval(&study::sphrs_set(n), d);
+            let e = study::band_identity_error(&peer, n);
+            if n <= 10 {
+                assert!(e < 1e-12, "sphrs at {n} bands: {e}");
+            }
+        }
+        let e20 = study::band_identity_error(&study::sphrs_eval(&study::sphrs_set(20), d), 20);
+        assert!(e20.is_nan() || e20 >= 1.0, "sphrs at 20 bands: {e20}");
+    }
 }

@@ -135,15 +135,7 @@ mod tests {
     extern crate std;
     use steradian_reference::sh as reference;
 
-    fn rng(seed: u64) -> impl FnMut() -> f32 {
-        let mut s = seed;
-        move || {
-            s = s
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            ((s >> 40) as f32 / (1u64 << 24) as f32) * 2.0 - 1.0
-        }
-    }
+    use crate::sh::test_rng as rng;
 
     /// The zonal function `Σ z_l·Y_l^0` rotated to the unit axis `a`, as full coefficients.
     fn zonal_to_full(z: &[f64], a: [f64; 3]) -> Vec<f64> {

@@ -169,13 +169,7 @@ mod tests {
     #[test]
     fn irradiance_against_quadrature() {
         let n = 8;
-        let mut s = 0x1d_u64;
-        let mut next = || {
-            s = s
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            ((s >> 40) as f32 / (1u64 << 24) as f32) * 2.0 - 1.0
-        };
+        let mut next = crate::sh::test_rng(0x1d);
         let coeffs: Vec<f32> = (0..n * n).map(|_| next()).collect();
         let mut scratch = vec![0.0; n * n];
         for normal in [Vec3::Z, Vec3::new(0.3, -0.4, 0.5), -Vec3::X] {
@@ -207,13 +201,7 @@ mod tests {
 
     #[test]
     fn the_nine_coefficient_and_two_by_two_forms_equal_the_general_one() {
-        let mut s = 11u64;
-        let mut r = || {
-            s = s
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            ((s >> 40) as f32 / (1u64 << 24) as f32) * 2.0 - 1.0
-        };
+        let mut r = crate::sh::test_rng(11);
         let mut scratch = [0.0f32; 9];
         for _ in 0..200 {
             let c: [f32; 9] = core::array::from_fn(|_| r());

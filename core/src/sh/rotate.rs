@@ -587,15 +587,7 @@ mod tests {
     use std::println;
     use steradian_reference::sh as reference;
 
-    fn rng(seed: u64) -> impl FnMut() -> f32 {
-        let mut s = seed;
-        move || {
-            s = s
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            ((s >> 40) as f32 / (1u64 << 24) as f32) * 2.0 - 1.0
-        }
-    }
+    use crate::sh::test_rng as rng;
 
     fn random_vector(bands: usize, seed: u64) -> Vec<f32> {
         let mut r = rng(seed);

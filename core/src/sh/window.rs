@@ -103,6 +103,28 @@ impl Window {
         }
     }
 
+    /// The windowed zonal function `Σ_l w_l·c_l·√((2l+1)/(4π))·P_l(t)` at `t = cos θ`, for the
+    /// zonal coefficients `zonal` (`n = zonal.len()` bands, `P_l` by the three-term
+    /// recurrence), in `f64`: the reconstruction the windows are judged on (module docs).
+    pub fn reconstruct_zonal(&self, zonal: &[f64], t: f64) -> f64 {
+        let n = zonal.len();
+        let (mut p0, mut p1) = (1.0f64, t);
+        let mut s = 0.0;
+        for (l, &c) in zonal.iter().enumerate() {
+            let p = if l == 0 { 1.0 } else { p1 };
+            s += self.weight(l, n)
+                * c
+                * math::sqrt64((2 * l + 1) as f64 / (4.0 * core::f64::consts::PI))
+                * p;
+            if l >= 1 {
+                let lf = l as f64;
+                let next = ((2.0 * lf + 1.0) * t * p1 - lf * p0) / (lf + 1.0);
+                (p0, p1) = (p1, next);
+            }
+        }
+        s
+    }
+
     /// Scales each band of the full expansion `coeffs` (`n²` values) by `w_l`, in place.
     ///
     /// Errors: a length that is not a square; invalid parameters ([`Window::validate`]).
@@ -158,26 +180,6 @@ mod tests {
         v
     }
 
-    /// `Σ_l w_l·c_l·√((2l+1)/4π)·P_l(t)`: the windowed zonal function at `cos θ = t`.
-    fn reconstruct(w: &Window, c: &[f64], t: f64) -> f64 {
-        let n = c.len();
-        let (mut p0, mut p1) = (1.0f64, t);
-        let mut s = 0.0;
-        for l in 0..n {
-            let p = if l == 0 { 1.0 } else { p1 };
-            s += w.weight(l, n)
-                * c[l]
-                * ((2 * l + 1) as f64 / (4.0 * core::f64::consts::PI)).sqrt()
-                * p;
-            if l >= 1 {
-                let lf = l as f64;
-                let next = ((2.0 * lf + 1.0) * t * p1 - lf * p0) / (lf + 1.0);
-                (p0, p1) = (p1, next);
-            }
-        }
-        s
-    }
-
     #[test]
     fn weights_start_at_one_stay_in_the_unit_interval_and_decrease() {
         for w in ALL {
@@ -206,10 +208,10 @@ mod tests {
             let dirac: Vec<f64> = (0..n)
                 .map(|l| ((2 * l + 1) as f64 / (4.0 * core::f64::consts::PI)).sqrt())
                 .collect();
-            let k0 = reconstruct(&Window::Cesaro, &dirac, 1.0);
+            let k0 = Window::Cesaro.reconstruct_zonal(&dirac, 1.0);
             let min = ts
                 .iter()
-                .map(|&t| reconstruct(&Window::Cesaro, &dirac, t))
+                .map(|&t| Window::Cesaro.reconstruct_zonal(&dirac, t))
                 .fold(f64::INFINITY, f64::min);
             assert!(min >= -1e-13 * k0, "n {n}: min {min:e} of peak {k0:e}");
         }
@@ -246,7 +248,7 @@ mod tests {
                 for (k, w) in ALL.iter().enumerate() {
                     let min = ts
                         .iter()
-                        .map(|&t| reconstruct(w, &c, t))
+                        .map(|&t| w.reconstruct_zonal(&c, t))
                         .fold(f64::INFINITY, f64::min);
                     worst[k] = worst[k].min(min / peak);
                     if *w == Window::Cesaro {

@@ -311,19 +311,7 @@ fn window_rows() -> Vec<(&'static str, f64)> {
                 );
                 for c in &lobes {
                     for &t in &ts {
-                        let (mut p0, mut p1) = (1.0f64, t);
-                        let mut s = 0.0;
-                        for (l, cl) in c.iter().enumerate() {
-                            let p = if l == 0 { 1.0 } else { p1 };
-                            s += w.weight(l, n)
-                                * cl
-                                * ((2 * l + 1) as f64 / (4.0 * std::f64::consts::PI)).sqrt()
-                                * p;
-                            if l >= 1 {
-                                let lf = l as f64;
-                                (p0, p1) = (p1, ((2.0 * lf + 1.0) * t * p1 - lf * p0) / (lf + 1.0));
-                            }
-                        }
+                        let s = w.reconstruct_zonal(c, t);
                         worst = worst.min(s);
                     }
                 }
