@@ -19,6 +19,7 @@ pub mod registry;
 pub mod report;
 pub mod rng;
 pub mod sat;
+pub mod scene;
 pub mod sh;
 pub mod shade;
 pub mod vdt;

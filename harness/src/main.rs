@@ -1,16 +1,16 @@
-//! The `steradian` command-line tool: `report`, `eval`, `tables`.
+//! The `steradian` command-line tool: `report`, `eval`, `tables`, `render`.
 
 use std::path::PathBuf;
 use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
-use steradian_harness::{eval, generate, report};
+use steradian_harness::{eval, generate, report, scene};
 
 #[derive(Parser)]
 #[command(
     name = "steradian",
     version,
-    about = "Fast, accurate spherical lighting integrals: report, eval, tables"
+    about = "Fast, accurate spherical lighting integrals: report, eval, tables, render"
 )]
 struct Cli {
     #[command(subcommand)]
@@ -60,10 +60,114 @@ enum Command {
         #[arg(long)]
         dir: Option<PathBuf>,
     },
+    /// Render a scene (a JSON file or builtin:NAME) with one method; write DIR/M.exr,
+    /// DIR/M.png and DIR/M.json, and compare with DIR/path.exr when it exists.
+    Render {
+        /// Scene file, or builtin:lobes, builtin:cluster, builtin:environment, builtin:room.
+        scene: String,
+        /// Method: path (the reference) or lobes.
+        #[arg(long, default_value = "path")]
+        method: String,
+        /// Output directory.
+        #[arg(long, default_value = "render")]
+        out: PathBuf,
+        /// Samples per pixel (path).
+        #[arg(long, default_value_t = 64)]
+        spp: u32,
+        /// Indirect bounces (path; 0 is direct lighting).
+        #[arg(long, default_value_t = 0)]
+        bounces: u32,
+        /// The error the approximations plan for: mean |difference| over the maximum
+        /// radiance.
+        #[arg(long, default_value_t = 0.0028)]
+        target_error: f64,
+        /// Exposure of the PNG in EV (the PNG is srgb(radiance·2^EV)).
+        #[arg(long, default_value_t = 0.0)]
+        exposure: f64,
+        /// Override the scene's image width (the height follows the aspect ratio).
+        #[arg(long)]
+        width: Option<u32>,
+        /// Seed of the path tracer's sample streams.
+        #[arg(long, default_value_t = 1)]
+        seed: u64,
+        /// No progress bar.
+        #[arg(long)]
+        quiet: bool,
+    },
+}
+
+fn render(
+    spec: &str,
+    width: Option<u32>,
+    method: &str,
+    mut o: scene::render::Options,
+) -> Result<(), String> {
+    o.method = scene::render::Method::parse(method)?;
+    let mut s = scene::Scene::load(spec).map_err(|e| e.to_string())?;
+    if let Some(w) = width {
+        s.camera = s.camera.resized(w).map_err(|e| format!("--width: {e}"))?;
+    }
+    let (plan, _) = scene::render::plan(&s, &o)?;
+    eprintln!("plan ({}):", o.method.name());
+    for p in &plan {
+        eprintln!("  {} = {}: {}", p.item, p.value, p.reason);
+    }
+    let out = scene::render::run(&s, spec, &o)?;
+    eprintln!(
+        "{}: {}×{} in {:.2} s, written to {}",
+        o.method.name(),
+        s.camera.width,
+        s.camera.height,
+        out.seconds,
+        o.out.display()
+    );
+    if let Some(m) = &out.metrics {
+        eprintln!(
+            "against path.exr: mean |diff| {:.3e} of max {:.3}, rel L2 {:.3e}, RMSE {:.4}, PSNR {:.1} dB, SSIM {:.4}; reference noise {:.2e}",
+            m.mean_abs_over_max,
+            m.max_radiance,
+            m.rel_l2,
+            m.rmse,
+            m.psnr_db,
+            m.ssim,
+            m.reference_noise_over_max
+        );
+    }
+    Ok(())
 }
 
 fn main() -> ExitCode {
     match Cli::parse().command {
+        Command::Render {
+            scene: spec,
+            method,
+            out,
+            spp,
+            bounces,
+            target_error,
+            exposure,
+            width,
+            seed,
+            quiet,
+        } => {
+            let o = scene::render::Options {
+                method: scene::render::Method::Path,
+                out,
+                spp,
+                bounces,
+                target_error,
+                exposure,
+                seed,
+                quiet,
+            };
+            match render(&spec, width, &method, o) {
+                Ok(()) => ExitCode::SUCCESS,
+                Err(e) => {
+                    eprintln!("error: {e}");
+                    ExitCode::FAILURE
+                }
+            }
+        }
         Command::Report {
             out,
             n,

@@ -14,6 +14,7 @@ mod product;
 mod product_gpu;
 mod properties;
 mod sat;
+mod scene;
 mod sh;
 mod sh_gpu;
 mod shade;

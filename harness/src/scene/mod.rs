@@ -1,0 +1,264 @@
+//! Scenes: spheres and planes with materials, spherical lights and an environment, a pinhole
+//! camera; read from JSON ([`file`]), rendered by the methods of [`render`] and compared
+//! with the path-traced reference of [`path`].
+//!
+//! Conventions (the scene-file contract, README "Scene files"):
+//! - Camera: forward `f = normalize(target − eye)`, right `r = normalize(f × up)`,
+//!   up `u = r × f`; pixel `(i, j)` (column from the left, row from the top) at offset
+//!   `(x, y)` in `[0, 1)²` inside the pixel looks along
+//!   `normalize(f + X·r + Y·u)` with `X = (2(i + x)/W − 1)·tan(fov_y/2)·W/H` and
+//!   `Y = (1 − 2(j + y)/H)·tan(fov_y/2)`; the pixel centre is `x = y = ½`.
+//! - A spherical light emits its radiance uniformly from its surface, is seen by the camera
+//!   at that radiance, reflects nothing and occludes everything behind it.
+//! - An environment is seen by rays that escape; its image is sampled bilinearly
+//!   ([`crate::env::Equirect::sample_bilinear`]: column ↔ `φ = 2πu` from `+x` toward `+y`,
+//!   row ↔ `θ = πv` from `+z`), times `scale`.
+//! - Planes are two-sided (the normal is flipped toward the viewer); spheres are seen from
+//!   outside.
+
+pub mod builtin;
+pub mod file;
+pub mod geom;
+pub mod image;
+pub mod light;
+pub mod lobes;
+pub mod material;
+pub mod metrics;
+pub mod path;
+pub mod render;
+
+use std::path::Path;
+
+use glam::DVec3;
+
+pub use geom::{Camera, Hit, Ray, Shape};
+pub use light::{Environment, SphereLight};
+pub use material::Material;
+
+/// RGB radiance in f64.
+pub type Rgb = [f64; 3];
+
+/// What an object is: a surface with a material, or a light.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Kind {
+    /// A reflecting surface; index into [`Scene::materials`].
+    Surface(usize),
+    /// An emitter; index into [`Scene::lights`].
+    Light(usize),
+}
+
+/// One intersectable object.
+#[derive(Clone, Copy, Debug)]
+pub struct Object {
+    /// Its shape.
+    pub shape: Shape,
+    /// Surface or light.
+    pub kind: Kind,
+}
+
+/// A validated scene, ready to render.
+#[derive(Clone, Debug)]
+pub struct Scene {
+    /// The camera.
+    pub camera: Camera,
+    /// Materials, indexed by [`Kind::Surface`].
+    pub materials: Vec<Material>,
+    /// Material names, parallel to `materials`.
+    pub material_names: Vec<String>,
+    /// All objects: surfaces first (spheres, then planes), then the light spheres.
+    pub objects: Vec<Object>,
+    /// The spherical lights, indexed by [`Kind::Light`].
+    pub lights: Vec<SphereLight>,
+    /// The environment, if any.
+    pub environment: Option<Environment>,
+}
+
+/// A scene that could not be read: the message names the field.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct SceneError(pub String);
+
+impl std::fmt::Display for SceneError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(&self.0)
+    }
+}
+
+impl std::error::Error for SceneError {}
+
+fn v3(a: [f64; 3]) -> DVec3 {
+    DVec3::from_array(a)
+}
+
+impl Scene {
+    /// Reads `builtin:NAME` or a scene file.
+    pub fn load(spec: &str) -> Result<Scene, SceneError> {
+        if let Some(name) = spec.strip_prefix("builtin:") {
+            let text = builtin::text(name).ok_or_else(|| {
+                SceneError(format!(
+                    "unknown built-in scene {name:?} (known: {})",
+                    builtin::NAMES.join(", ")
+                ))
+            })?;
+            return Scene::from_json(text, &builtin::dir());
+        }
+        let path = Path::new(spec);
+        let text = std::fs::read_to_string(path)
+            .map_err(|e| SceneError(format!("reading {}: {e}", path.display())))?;
+        let dir = path.parent().unwrap_or(Path::new("."));
+        Scene::from_json(&text, dir)
+    }
+
+    /// Parses and validates JSON text; relative environment files are resolved from `dir`.
+    pub fn from_json(text: &str, dir: &Path) -> Result<Scene, SceneError> {
+        let f = file::parse(text).map_err(SceneError)?;
+        Scene::from_file(&f, dir)
+    }
+
+    /// Validates the cross-field rules of a parsed file and builds the scene.
+    pub fn from_file(f: &file::SceneFile, dir: &Path) -> Result<Scene, SceneError> {
+        let err = |s: String| SceneError(s);
+        let c = &f.camera;
+        let camera = Camera::new(
+            v3(c.eye.0),
+            v3(c.target.0),
+            v3(c.up.0),
+            c.fov_y.0,
+            c.width.0,
+            c.height.0,
+        )
+        .map_err(|m| err(format!("camera.{m}")))?;
+        let mut materials = Vec::new();
+        let mut material_names = Vec::new();
+        for (name, m) in &f.materials {
+            materials
+                .push(Material::from_file(m).map_err(|e| err(format!("materials.{name}.{e}")))?);
+            material_names.push(name.clone());
+        }
+        let find = |name: &str, at: String| -> Result<usize, SceneError> {
+            material_names
+                .iter()
+                .position(|n| n == name)
+                .ok_or_else(|| {
+                    err(format!(
+                        "{at}.material: unknown material {name:?} (defined: {})",
+                        material_names.join(", ")
+                    ))
+                })
+        };
+        let mut objects = Vec::new();
+        for (i, s) in f.spheres.iter().enumerate() {
+            let m = find(&s.material, format!("spheres[{i}]"))?;
+            objects.push(Object {
+                shape: Shape::Sphere {
+                    center: v3(s.center.0),
+                    radius: s.radius.0,
+                },
+                kind: Kind::Surface(m),
+            });
+        }
+        for (i, p) in f.planes.iter().enumerate() {
+            let m = find(&p.material, format!("planes[{i}]"))?;
+            objects.push(Object {
+                shape: Shape::Plane {
+                    point: v3(p.point.0),
+                    normal: v3(p.normal.0).normalize(),
+                },
+                kind: Kind::Surface(m),
+            });
+        }
+        let mut lights = Vec::new();
+        let mut environment = None;
+        for (i, l) in f.lights.iter().enumerate() {
+            match l {
+                file::LightFile::Sphere {
+                    center,
+                    radius,
+                    radiance,
+                } => {
+                    let light = SphereLight {
+                        center: v3(center.0),
+                        radius: radius.0,
+                        radiance: radiance.0,
+                    };
+                    objects.push(Object {
+                        shape: Shape::Sphere {
+                            center: light.center,
+                            radius: light.radius,
+                        },
+                        kind: Kind::Light(lights.len()),
+                    });
+                    lights.push(light);
+                }
+                file::LightFile::Environment { file, scale } => {
+                    if environment.is_some() {
+                        return Err(err(format!(
+                            "lights[{i}].environment: only one environment is allowed"
+                        )));
+                    }
+                    environment = Some(
+                        Environment::load(file, dir, scale.0)
+                            .map_err(|e| err(format!("lights[{i}].environment.file: {e}")))?,
+                    );
+                }
+            }
+        }
+        let scene = Scene {
+            camera,
+            materials,
+            material_names,
+            objects,
+            lights,
+            environment,
+        };
+        if scene.camera_inside_sphere() {
+            return Err(err("camera.eye: inside a sphere".into()));
+        }
+        Ok(scene)
+    }
+
+    fn camera_inside_sphere(&self) -> bool {
+        self.objects.iter().any(|o| match o.shape {
+            Shape::Sphere { center, radius } => (self.camera.eye - center).length() <= radius,
+            Shape::Plane { .. } => false,
+        })
+    }
+
+    /// The closest hit along `ray` with `t` in `(t_min, t_max)`.
+    pub fn intersect(&self, ray: &Ray, t_min: f64, t_max: f64) -> Option<Hit> {
+        let mut best: Option<Hit> = None;
+        let mut t_far = t_max;
+        for (id, o) in self.objects.iter().enumerate() {
+            if let Some(t) = o.shape.intersect(ray, t_min, t_far) {
+                t_far = t;
+                best = Some(Hit { t, object: id });
+            }
+        }
+        best
+    }
+
+    /// Whether anything blocks `ray` within `(t_min, t_max)`.
+    pub fn occluded(&self, ray: &Ray, t_min: f64, t_max: f64) -> bool {
+        self.objects
+            .iter()
+            .any(|o| o.shape.intersect(ray, t_min, t_max).is_some())
+    }
+
+    /// Environment radiance toward `d` (black without an environment).
+    pub fn environment_radiance(&self, d: DVec3) -> Rgb {
+        self.environment
+            .as_ref()
+            .map_or([0.0; 3], |e| e.radiance(d))
+    }
+
+    /// A scale for intersection offsets: the size of the scene around the camera.
+    pub fn epsilon(&self) -> f64 {
+        let mut s = self.camera.eye.abs().max_element();
+        for o in &self.objects {
+            s = s.max(match o.shape {
+                Shape::Sphere { center, radius } => center.abs().max_element() + radius,
+                Shape::Plane { point, .. } => point.abs().max_element(),
+            });
+        }
+        1e-9 * s.max(1.0)
+    }
+}
