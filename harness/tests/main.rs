@@ -10,6 +10,7 @@ mod env;
 mod fuzz_replay;
 mod gpu;
 mod lobe_sum;
+mod mask;
 mod product;
 mod product_gpu;
 mod properties;

@@ -323,12 +323,13 @@ fn lobes_method_unshadowed_lambert_is_within_the_cap_fit() {
 
 /// The built-in scenes that the `lobes` method lights, at 64 columns: its error against
 /// the path tracer (direct light, 256 samples per pixel) stays within the bound measured
-/// here plus four times the reference's noise, and the energy-preserving cap fit (the
-/// method's default) beats the L2 fit on both. Measured (1024 samples per pixel): `lobes`
-/// 1.8e-3 (L2: 4.1e-3), `cluster` 5.1e-3 (L2: 1.65e-2) of the maximum radiance.
+/// here plus four times the reference's noise; the quadtree mask (the default) beats one
+/// lobe per occluder, and the energy-preserving cap fit (the default) beats the L2 fit.
 #[test]
 fn lobes_method_against_the_path_tracer_on_small_builtin_scenes() {
-    for (name, bound) in [("lobes", 0.0022), ("cluster", 0.006)] {
+    use lobes::Visibility;
+    let per = Visibility::PerOccluder;
+    for (name, bound) in [("lobes", 0.0015), ("cluster", 0.004)] {
         let mut s = Scene::load(&format!("builtin:{name}")).unwrap();
         s.camera = s.camera.resized(64).unwrap();
         let hidden = ProgressBar::hidden();
@@ -341,28 +342,41 @@ fn lobes_method_against_the_path_tracer_on_small_builtin_scenes() {
             },
             &hidden,
         );
+        let d = lobes::Options::default();
+        let variants = [
+            d,
+            lobes::Options {
+                visibility: per,
+                ..d
+            },
+            lobes::Options {
+                fit: CapFit::L2,
+                ..d
+            },
+        ];
         let mut errors = Vec::new();
-        for fit in [CapFit::EnergyPreserving, CapFit::L2] {
-            let o = lobes::Options {
-                fit,
-                ..Default::default()
-            };
+        for o in variants {
             let (img, _) = lobes::render(&s, &o, &hidden);
             let m =
                 metrics::compare(&s, &img, &reference.image, Some(&reference.stderr), 0.0).unwrap();
-            eprintln!("{name} {fit:?}: {m:?}");
+            eprintln!("{name} {:?} {:?}: {m:?}", o.fit, o.visibility);
             assert!(m.shaded_pixels > 1000);
             errors.push((m.mean_abs_over_max, m.reference_noise_over_max));
         }
-        let (ep, noise) = errors[0];
+        let (e, noise) = errors[0];
         assert!(
-            ep <= bound + 4.0 * noise,
-            "{name}: mean |diff| {ep} > {bound} + 4·{noise}"
+            e <= bound + 4.0 * noise,
+            "{name}: mean |diff| {e} > {bound} + 4·{noise}"
         );
         assert!(
-            ep < errors[1].0,
-            "{name}: energy-preserving {ep} vs L2 {}",
+            e < errors[1].0,
+            "{name}: mask {e} vs per occluder {}",
             errors[1].0
+        );
+        assert!(
+            e < errors[2].0,
+            "{name}: energy-preserving {e} vs L2 {}",
+            errors[2].0
         );
     }
 }

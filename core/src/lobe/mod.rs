@@ -34,6 +34,7 @@
 
 pub mod brdf;
 pub mod cap;
+pub mod mask;
 pub mod product;
 pub mod sum;
 

@@ -6,6 +6,7 @@
 pub mod brdf_sh;
 pub mod cap_exponent;
 pub mod lobe_product;
+pub mod mask_weights;
 
 use std::path::{Path, PathBuf};
 
@@ -30,6 +31,11 @@ pub const TABLES: &[TableDef] = &[
         file: "lobe/tables/lobe_product.bin",
         about: "g = ln I − ln B, the lobe-product integral's correction to its closed-form baseline",
         generate: lobe_product::generate,
+    },
+    TableDef {
+        file: "lobe/tables/mask_weights.bin",
+        about: "w(dist, depth), the quadtree mask's leaf weights, least squares against exact visibility",
+        generate: mask_weights::generate,
     },
     TableDef {
         file: "sh/tables/brdf_lambert.bin",

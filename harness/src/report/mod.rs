@@ -8,6 +8,7 @@ pub mod plot;
 pub mod product;
 pub mod rsl;
 pub mod sat;
+pub mod scenes;
 pub mod section;
 pub mod sections;
 pub mod sh;

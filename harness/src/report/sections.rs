@@ -16,6 +16,7 @@ pub const PRODUCERS: &[(&str, Producer)] = &[
     ("rsl", super::rsl::section),
     ("shade", super::shade::section),
     ("sh", super::sh::section),
+    ("scenes", super::scenes::section),
 ];
 
 /// Runs every section producer, or only the one `opts.only` names.

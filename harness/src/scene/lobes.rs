@@ -10,8 +10,9 @@
 //!   per glossy lobe (modified Phong: about the mirror direction, `(n+2)/(2π)` carried in
 //!   RGB; Lafortune: about `M·ωo`), each chained separately so that every colour channel
 //!   is an exact scale of the same scalar integral;
-//! - visibility is `1 − Σ_k w·c_k` (eq. 39–41) over the occluder lobes `c_k` of
-//!   [`Visibility`].
+//! - visibility is `1 − Σ_k w_k·c_k` (eq. 39–41): by default over the shadow leaves of the
+//!   quadtree mask of section 5.3 with the fitted weights ([`Visibility::Mask`]), or one
+//!   lobe of weight 1 per occluder ([`Visibility::PerOccluder`]).
 //!
 //! Occluders are the spheres of the scene (surfaces and other lights) whose centre is
 //! nearer than the light's and whose cap overlaps the light's cap (`angle(a_l, a_o) <
@@ -29,6 +30,7 @@ use indicatif::ProgressBar;
 use rayon::prelude::*;
 use steradian_core::lobe::CosineLobe;
 use steradian_core::lobe::cap::{CapFit, SphericalCap};
+use steradian_core::lobe::mask::{self, Leaves};
 use steradian_core::lobe::sum::{
     Cosine, LobeSum, LobeVec, ProductCounts, light_with_cosine, triple,
 };
@@ -42,6 +44,14 @@ pub enum Visibility {
     /// One lobe per overlapping occluder sphere, weight 1: overlapping occluders are
     /// subtracted twice.
     PerOccluder,
+    /// The quadtree mask of section 5.3 ([`steradian_core::lobe::mask`]): one lobe per
+    /// shadow leaf, weighted by the fitted table.
+    Mask {
+        /// Deepest level (1–5).
+        depth: u32,
+        /// What a partially covered deepest cell becomes.
+        leaves: Leaves,
+    },
 }
 
 /// Settings of the `lobes` method.
@@ -63,7 +73,10 @@ impl Default for Options {
         Options {
             fit: CapFit::EnergyPreserving,
             threshold: 1e-4,
-            visibility: Visibility::PerOccluder,
+            visibility: Visibility::Mask {
+                depth: mask::MAX_DEPTH,
+                leaves: Leaves::Centre,
+            },
         }
     }
 }
@@ -123,6 +136,7 @@ pub fn shade(scene: &Scene, p: &ShadingPoint, o: &Options, counts: &mut ProductC
             lobes: Vec::new(),
         };
         let (d_light, a_light) = (rel.length(), cap.half_angle() as f64);
+        let mut occluders = Vec::new();
         for (id, obj) in scene.objects.iter().enumerate() {
             if id == self_id || obj.kind == Kind::Light(li) {
                 continue;
@@ -141,10 +155,19 @@ pub fn shade(scene: &Scene, p: &ShadingPoint, o: &Options, counts: &mut ProductC
             if between >= a_light + oc.half_angle() as f64 {
                 continue;
             }
-            match o.visibility {
-                Visibility::PerOccluder => {
-                    vis.lobes.push(oc.lobe(-1.0, o.fit));
-                }
+            occluders.push(oc);
+        }
+        match o.visibility {
+            Visibility::PerOccluder => {
+                vis.lobes
+                    .extend(occluders.iter().map(|oc| oc.lobe(-1.0, o.fit)));
+            }
+            Visibility::Mask { depth, leaves } => {
+                let dist = mask::dist_of(cap.half_angle());
+                mask::shadow_leaves(&cap, &occluders, depth, leaves, |leaf, d| {
+                    let w = mask::weight(&mask::WEIGHTS, dist, d);
+                    vis.lobes.push(leaf.lobe(-w, o.fit));
+                });
             }
         }
         let unoccluded = LobeSum::<1>::unoccluded();

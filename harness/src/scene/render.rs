@@ -160,8 +160,14 @@ pub fn plan(scene: &Scene, o: &Options) -> Result<(Vec<PlanItem>, lobes::Options
             });
             p.push(PlanItem {
                 item: "visibility".into(),
-                value: json!("per-occluder"),
-                reason: "one lobe of weight 1 per sphere whose cap overlaps the light's".into(),
+                value: json!(format!(
+                    "quadtree mask, depth {}",
+                    steradian_core::lobe::mask::MAX_DEPTH
+                )),
+                reason:
+                    "section 5.3: one lobe per shadow leaf with the fitted weights w(dist, depth) \
+                         (the table's fit depth); overlapping occluders are counted once"
+                        .into(),
             });
         }
     }

@@ -1,0 +1,301 @@
+//! Sphere-set visibility as a quadtree mask and weighted leaf lobes (cosine-lobe paper,
+//! section 5.3, Figures 9–10, eq. 39–41).
+//!
+//! One lobe per occluder (`V = 1 − Σ c_k`) subtracts the overlap of two occluders twice.
+//! The paper instead splats the occluders into a quadtree over a square that surrounds the
+//! light's cone and turns each *shadow leaf* into one lobe, weighted by `w(dist, depth)`:
+//! `V = 1 − Σ_i w(dist, d_i)·c_i`.
+//!
+//! **The square.** Seen from the shading point (the origin), the light's cap has axis `h`
+//! and half-angle `α`. The paper's unit square `S_unit` is placed across `h` at the
+//! distance `dist` where it circumscribes the cone's cross-section: half-side `½ =
+//! dist·tan α`, so `dist = 1/(2 tan α)` (a scale-free stand-in for `α`; the square lies
+//! behind the light when `dist` exceeds the light's distance, as the paper notes). Here it
+//! is used at unit distance: gnomonic coordinates `(p, q) ∈ [−tan α, tan α]²`, direction
+//! `normalize(h + p·t + q·b)`.
+//!
+//! **The quadtree** (Figure 9). A cell is *covered* when one occluder cap holds its four
+//! corner directions (the cap's central projection is convex, so it holds the whole
+//! cell): it becomes a shadow leaf and is not subdivided. A cell that no occluder can
+//! touch (`angle(a_j, centre) > β_j + γ`, `γ` the cell's angular radius) or that lies
+//! wholly outside the light's cap is not considered. Any other cell is subdivided, down to
+//! `max_depth`, where a partially covered cell is dropped ([`Leaves::Aggressive`]), kept
+//! ([`Leaves::Conservative`]) — the paper's two choices — or kept when its centre is
+//! covered ([`Leaves::Centre`], the midpoint rule, this crate's default).
+//!
+//! **Leaf lobes.** A leaf of half-side `s` centred at `c` (on the unit-distance plane) is
+//! bounded by the sphere of centre `c` and radius `√2·s`; its lobe is that sphere's cap
+//! as a lobe, like a light's (eq. 31–32), with scale `−w`.
+//!
+//! **Weights.** The paper tuned `w` by hand per `dist` and depth (a first-level weight for
+//! a dark umbra, then each level against the previous). Here they are fitted once in the
+//! harness (`generate::mask_weights`) by least squares against exact visibility — the
+//! unoccluded fraction of the light's cap — over random occluder configurations, and
+//! committed as the table [`WEIGHT_TABLE_BYTES`] (`steradian tables --check`), read with
+//! linear interpolation in `ln dist` ([`weight`]).
+
+use crate::Vec3;
+use crate::lobe::cap::SphericalCap;
+use crate::math;
+use crate::table::{Header, decode_const};
+
+/// Deepest level a mask subdivides to (the paper: "practically limited to 4 or 5").
+pub const MAX_DEPTH: u32 = 5;
+/// Depth levels in the weight table (`0..=MAX_DEPTH`).
+pub const WEIGHT_DEPTHS: usize = MAX_DEPTH as usize + 1;
+/// `dist` samples of the weight table, uniform in `ln dist` over [`WEIGHT_DIST_RANGE`].
+pub const WEIGHT_DISTS: usize = 12;
+/// The range of `dist` in the weight table (`α` from 82.9° to 0.9°); clamped outside.
+pub const WEIGHT_DIST_RANGE: (f32, f32) = (0.0625, 32.0);
+/// Number of weights: value `i + WEIGHT_DISTS·depth` is the weight at the `i`-th `dist`.
+pub const WEIGHT_LEN: usize = WEIGHT_DISTS * WEIGHT_DEPTHS;
+/// Name of the weight table.
+pub const WEIGHT_TABLE_NAME: &str = "mask-weights";
+/// The committed weight table.
+pub static WEIGHT_TABLE_BYTES: &[u8] = include_bytes!("tables/mask_weights.bin");
+const DECODED: (Header, [f32; WEIGHT_LEN]) =
+    decode_const(include_bytes!("tables/mask_weights.bin"), WEIGHT_TABLE_NAME);
+/// The decoded weight table.
+pub static WEIGHTS: [f32; WEIGHT_LEN] = DECODED.1;
+
+/// What a partially covered cell at the deepest level becomes.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Leaves {
+    /// Dropped (lit): the paper's aggressive variant.
+    Aggressive,
+    /// Kept (shadow): the paper's conservative variant.
+    Conservative,
+    /// Kept when its centre direction is covered: the midpoint rule.
+    #[default]
+    Centre,
+}
+
+/// `dist = 1/(2 tan α)` of a light cap of half-angle `α` (see the module docs).
+pub fn dist_of(half_angle: f32) -> f32 {
+    math::cosf(half_angle) / (2.0 * math::sinf(half_angle))
+}
+
+/// The fitted weight at `dist` and `depth`, interpolated linearly in `ln dist` (clamped to
+/// the table's range; a depth beyond [`MAX_DEPTH`] reads the deepest level).
+pub fn weight(table: &[f32], dist: f32, depth: u32) -> f32 {
+    let (lo, hi) = WEIGHT_DIST_RANGE;
+    let u = (math::logf(dist.clamp(lo, hi)) - math::logf(lo)) / (math::logf(hi) - math::logf(lo));
+    let x = u * (WEIGHT_DISTS - 1) as f32;
+    let i = (math::floorf(x) as usize).min(WEIGHT_DISTS - 2);
+    let f = x - i as f32;
+    let row = WEIGHT_DISTS * (depth.min(MAX_DEPTH) as usize);
+    let (a, b) = (table[row + i], table[row + i + 1]);
+    a + f * (b - a)
+}
+
+/// Occluder caps as the mask tests them.
+#[derive(Clone, Copy, Debug)]
+struct Occ {
+    axis: Vec3,
+    cos_b: f32,
+    half_angle: f32,
+}
+
+/// The square's frame and extent for one light.
+#[derive(Clone, Copy, Debug)]
+struct Square {
+    h: Vec3,
+    t: Vec3,
+    b: Vec3,
+    cos_a: f32,
+    half_angle: f32,
+}
+
+impl Square {
+    fn dir(&self, p: f32, q: f32) -> Vec3 {
+        (self.h + self.t * p + self.b * q).normalize()
+    }
+}
+
+/// Calls `leaf(cap, depth)` for every shadow leaf of the mask of `occluders` over `light`
+/// (see the module docs); returns the number of leaves. Occluder caps are given as seen
+/// from the shading point (the same origin as `light`); any subset may miss the light.
+pub fn shadow_leaves(
+    light: &SphericalCap,
+    occluders: &[SphericalCap],
+    max_depth: u32,
+    leaves: Leaves,
+    mut leaf: impl FnMut(SphericalCap, u32),
+) -> usize {
+    let max_depth = max_depth.min(MAX_DEPTH);
+    let h = light.axis();
+    let sign = if h.z >= 0.0 { 1.0 } else { -1.0 };
+    let a = -1.0 / (sign + h.z);
+    let bb = h.x * h.y * a;
+    let sq = Square {
+        h,
+        t: Vec3::new(1.0 + sign * h.x * h.x * a, sign * bb, -sign * h.x),
+        b: Vec3::new(bb, sign + h.y * h.y * a, -h.y),
+        cos_a: math::cosf(light.half_angle()),
+        half_angle: light.half_angle(),
+    };
+    // Beyond 80° the square's corners are near the horizon of the point: clamp.
+    let tan_a = (math::sinf(light.half_angle()) / sq.cos_a.max(0.17)).min(5.7);
+    let mut occ = [Occ {
+        axis: Vec3::Z,
+        cos_b: 1.0,
+        half_angle: 0.0,
+    }; 64];
+    let mut n = 0;
+    for o in occluders {
+        if n == occ.len() {
+            break;
+        }
+        occ[n] = Occ {
+            axis: o.axis(),
+            cos_b: math::cosf(o.half_angle()),
+            half_angle: o.half_angle(),
+        };
+        n += 1;
+    }
+    let mut count = 0;
+    visit(
+        &sq,
+        &occ[..n],
+        (0.0, 0.0, tan_a),
+        0,
+        max_depth,
+        leaves,
+        &mut |c, d| {
+            count += 1;
+            leaf(c, d)
+        },
+    );
+    count
+}
+
+fn angle_between(a: Vec3, b: Vec3) -> f32 {
+    math::acosf(a.dot(b).clamp(-1.0, 1.0))
+}
+
+fn visit(
+    sq: &Square,
+    occ: &[Occ],
+    (p, q, s): (f32, f32, f32),
+    depth: u32,
+    max_depth: u32,
+    leaves: Leaves,
+    leaf: &mut impl FnMut(SphericalCap, u32),
+) {
+    let centre = sq.dir(p, q);
+    let corners = [
+        sq.dir(p - s, q - s),
+        sq.dir(p + s, q - s),
+        sq.dir(p - s, q + s),
+        sq.dir(p + s, q + s),
+    ];
+    let gamma = corners
+        .iter()
+        .map(|c| angle_between(*c, centre))
+        .fold(0.0f32, f32::max);
+    // Wholly outside the light's cap: not considered.
+    if angle_between(centre, sq.h) - gamma > sq.half_angle {
+        return;
+    }
+    let mut touched = false;
+    for o in occ {
+        if corners.iter().all(|c| c.dot(o.axis) >= o.cos_b) {
+            emit(sq, (p, q, s), depth, leaf);
+            return;
+        }
+        if angle_between(o.axis, centre) <= o.half_angle + gamma {
+            touched = true;
+        }
+    }
+    if !touched {
+        return;
+    }
+    if depth >= max_depth {
+        let keep = match leaves {
+            Leaves::Aggressive => false,
+            Leaves::Conservative => true,
+            Leaves::Centre => occ.iter().any(|o| centre.dot(o.axis) >= o.cos_b),
+        };
+        if keep {
+            emit(sq, (p, q, s), depth, leaf);
+        }
+        return;
+    }
+    let h = s / 2.0;
+    for (dp, dq) in [(-h, -h), (h, -h), (-h, h), (h, h)] {
+        visit(
+            sq,
+            occ,
+            (p + dp, q + dq, h),
+            depth + 1,
+            max_depth,
+            leaves,
+            leaf,
+        );
+    }
+}
+
+/// The leaf's bounding sphere (centre on the unit-distance plane, radius `√2·s`) as a cap;
+/// a sphere that would hold the origin is shrunk to the largest that does not.
+fn emit(
+    sq: &Square,
+    (p, q, s): (f32, f32, f32),
+    depth: u32,
+    leaf: &mut impl FnMut(SphericalCap, u32),
+) {
+    let c = sq.h + sq.t * p + sq.b * q;
+    let d = c.length();
+    let r = (core::f32::consts::SQRT_2 * s).min(0.999 * d);
+    if let Ok(cap) = SphericalCap::from_sphere(Vec3::ZERO, c, r) {
+        leaf(cap, depth);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn dist_is_the_circumscribing_distance() {
+        // Half-side ½ at distance dist subtends tan α = ½/dist.
+        for a in [0.01f32, 0.3, 1.0] {
+            let d = dist_of(a);
+            assert!((0.5 / d - math::sinf(a) / math::cosf(a)).abs() < 1e-5 * (1.0 + 0.5 / d));
+        }
+    }
+
+    #[test]
+    fn no_occluder_no_leaf_and_a_covering_occluder_one_leaf() {
+        let light = SphericalCap::new(Vec3::Z, 0.1).unwrap();
+        assert_eq!(shadow_leaves(&light, &[], 5, Leaves::Centre, |_, _| {}), 0);
+        let big = SphericalCap::new(Vec3::Z, 0.5).unwrap();
+        let mut depths = [0u32; 8];
+        let n = shadow_leaves(&light, &[big], 5, Leaves::Centre, |_, d| {
+            depths[d as usize] += 1
+        });
+        assert_eq!((n, depths[0]), (1, 1));
+        // An occluder beside the light touches no cell.
+        let away = SphericalCap::new(Vec3::X, 0.2).unwrap();
+        assert_eq!(
+            shadow_leaves(&light, &[away], 5, Leaves::Centre, |_, _| {}),
+            0
+        );
+    }
+
+    /// Half the light covered by a large occluder whose rim runs through the light's
+    /// axis: the leaves' solid angle (their bounding caps overlap, so it exceeds the
+    /// area) is about half the square's, and aggressive ≤ centre ≤ conservative.
+    #[test]
+    fn a_half_covered_light() {
+        let light = SphericalCap::new(Vec3::Z, 0.05).unwrap();
+        let occ =
+            SphericalCap::new(Vec3::new(1.0, 0.0, 0.0), core::f32::consts::FRAC_PI_2).unwrap();
+        let count = |l| shadow_leaves(&light, &[occ], 5, l, |_, _| {});
+        let (a, c, k) = (
+            count(Leaves::Aggressive),
+            count(Leaves::Centre),
+            count(Leaves::Conservative),
+        );
+        assert!(a <= c && c <= k && a > 0, "{a} {c} {k}");
+    }
+}
