@@ -3,12 +3,15 @@
 //! path tracer's own (error against samples per pixel), so that a method reads as "the
 //! path tracer would need N× longer for the same error".
 //!
-//! Per scene (`lobes`, `cluster`, at [`WIDTH`] columns): the reference is the path tracer
-//! at [`REFERENCE_SPP`] samples per pixel (direct light); the path tracer's curve is the
-//! same tracer with other seeds at 1–64 samples; the `lobes` method's curve is its
-//! pruning threshold, with the L2 cap fit and one lobe per occluder (instead of the
-//! default energy-preserving fit and quadtree mask) beside it. Times
-//! are wall-clock seconds of whole renders on this machine's thread pool, both sides alike.
+//! Per scene of [`SCENES`] (at [`WIDTH`] columns): the reference is the path tracer at
+//! [`REFERENCE_SPP`] samples per pixel (direct light for `lobes` and `cluster`, one bounce
+//! for `room`); the path tracer's curve is the same tracer with other seeds at 1–64
+//! samples. The `lobes` method's curve is its pruning threshold, with the L2 cap fit and
+//! one lobe per occluder (instead of the default energy-preserving fit and quadtree mask)
+//! beside it; the `hvl` method's curve is its HVL count, with the paper's choice of no
+//! HVL visibility and the direct light alone beside it. Times
+//! are wall-clock seconds of whole renders on this machine's thread pool, both sides alike
+//! (the best of three for renders under 0.2 s).
 //! "Equal-error cost": the path tracer's time at the method's error, interpolated on its
 //! curve in log–log (error falls as `spp^−½`), over the method's time.
 
@@ -23,8 +26,9 @@ use steradian_core::lobe::cap::CapFit;
 use super::Options;
 use super::plot::{Axis, Chart, Pt, Scale, Series};
 use super::section::Section;
+use crate::scene::image::Image;
 use crate::scene::metrics::{self, Metrics};
-use crate::scene::{Scene, lobes, path};
+use crate::scene::{Scene, hvl, lobes, path};
 
 /// Image width of the section's renders (the height follows each scene's aspect ratio).
 pub const WIDTH: u32 = 128;
@@ -34,6 +38,8 @@ pub const REFERENCE_SPP: u32 = 512;
 const PATH_SPP: &[u32] = &[1, 2, 4, 8, 16, 64];
 /// Pruning thresholds of the `lobes` curve.
 const THRESHOLDS: &[f32] = &[0.0, 1e-4, 1e-3, 1e-2, 5e-2];
+/// Reflective-shadow-map face sides of the `hvl` curve.
+const HVL_SIDES: &[usize] = &[2, 4, 8, 12];
 
 /// One point of a curve.
 #[derive(Clone, Debug)]
@@ -47,14 +53,17 @@ struct Point {
 /// One scene's measurements.
 struct SceneResult {
     name: &'static str,
+    method: &'static str,
+    bounces: u32,
     width: u32,
     height: u32,
     reference_seconds: f64,
     path: Vec<Point>,
-    lobes: Vec<Point>,
-    lobes_l2: Point,
-    lobes_per: Point,
-    /// The path tracer's time at the default `lobes` point's error over that point's time.
+    /// The method's curve over its main setting.
+    curve: Vec<Point>,
+    /// Single points: the method with one choice changed.
+    variants: Vec<Point>,
+    /// The path tracer's time at the default point's error over that point's time.
     equal_error_ratio: f64,
     files: Vec<(String, Vec<u8>)>,
 }
@@ -89,21 +98,127 @@ fn path_seconds_at(curve: &[Point], err: f64) -> f64 {
     (t_end - 2.0 * (e - e_end)).exp()
 }
 
-fn measure_scene(name: &'static str, bar: &ProgressBar) -> Result<SceneResult, Box<dyn Error>> {
+/// A method's render under one setting: the image and its kernel products per pixel.
+type Render<'a> = Box<dyn Fn() -> (Image, Option<f64>) + 'a>;
+
+/// One setting to measure: its label, the render, and whether it is the default.
+struct Setting<'a> {
+    label: String,
+    render: Render<'a>,
+    default: bool,
+}
+
+fn lobes_settings(scene: &Scene) -> (Vec<Setting<'_>>, Vec<Setting<'_>>) {
+    let px = scene.camera.pixels() as f64;
+    let d = lobes::Options::default();
+    let mk = move |label: String, o: lobes::Options, default: bool| Setting {
+        label,
+        render: Box::new(move || {
+            let (img, c) = lobes::render(scene, &o, &ProgressBar::hidden());
+            (img, Some(c.computed as f64 / px))
+        }),
+        default,
+    };
+    let curve = THRESHOLDS
+        .iter()
+        .map(|&t| {
+            mk(
+                format!("t = {t:.0e}"),
+                lobes::Options { threshold: t, ..d },
+                t == d.threshold,
+            )
+        })
+        .collect();
+    let variants = vec![
+        mk(
+            format!("L2 cap fit, t = {:.0e}", d.threshold),
+            lobes::Options {
+                fit: CapFit::L2,
+                ..d
+            },
+            false,
+        ),
+        mk(
+            format!("one lobe per occluder, t = {:.0e}", d.threshold),
+            lobes::Options {
+                visibility: lobes::Visibility::PerOccluder,
+                ..d
+            },
+            false,
+        ),
+    ];
+    (curve, variants)
+}
+
+fn hvl_settings(scene: &Scene) -> (Vec<Setting<'_>>, Vec<Setting<'_>>) {
+    let d = hvl::Options::default();
+    let mk = move |label: String, o: hvl::Options, default: bool| Setting {
+        label,
+        render: Box::new(move || (hvl::render(scene, &o, &ProgressBar::hidden()).0, None)),
+        default,
+    };
+    let curve = HVL_SIDES
+        .iter()
+        .map(|&side| {
+            mk(
+                format!("{} HVLs", 6 * side * side * scene.lights.len()),
+                hvl::Options { side, ..d },
+                side == d.side,
+            )
+        })
+        .collect();
+    let px = scene.camera.pixels() as f64;
+    let direct = d.direct;
+    let variants = vec![
+        mk(
+            format!(
+                "{} HVLs, no HVL visibility (the paper)",
+                6 * d.side * d.side * scene.lights.len()
+            ),
+            hvl::Options {
+                visibility: false,
+                ..d
+            },
+            false,
+        ),
+        Setting {
+            label: "direct light only (lobes)".into(),
+            render: Box::new(move || {
+                let (img, c) = lobes::render(scene, &direct, &ProgressBar::hidden());
+                (img, Some(c.computed as f64 / px))
+            }),
+            default: false,
+        },
+    ];
+    (curve, variants)
+}
+
+fn png(img: &Image) -> Result<Vec<u8>, String> {
+    let mut bytes = Vec::new();
+    img.to_rgb8(0.0)
+        .write_to(
+            &mut std::io::Cursor::new(&mut bytes),
+            image::ImageFormat::Png,
+        )
+        .map_err(|e| e.to_string())?;
+    Ok(bytes)
+}
+
+fn measure_scene(
+    name: &'static str,
+    method: &'static str,
+    bounces: u32,
+    bar: &ProgressBar,
+) -> Result<SceneResult, Box<dyn Error>> {
     let mut scene = Scene::load(&format!("builtin:{name}"))?;
     scene.camera = scene.camera.resized(WIDTH)?;
     let hidden = ProgressBar::hidden();
-    let settings = |spp, seed| path::Settings {
-        spp,
-        bounces: 0,
-        seed,
-    };
+    let settings = |spp, seed| path::Settings { spp, bounces, seed };
     let (reference, reference_seconds) =
         timed(|| path::render(&scene, &settings(REFERENCE_SPP, 1), &hidden));
     bar.inc(1);
-    let compare = |img: &crate::scene::image::Image| {
-        metrics::compare(&scene, img, &reference.image, Some(&reference.stderr), 0.0)
-    };
+    let compare =
+        |img: &Image| metrics::compare(&scene, img, &reference.image, Some(&reference.stderr), 0.0);
     let mut path_curve = Vec::new();
     for &spp in PATH_SPP {
         let (out, s) = timed(|| path::render(&scene, &settings(spp, 1000 + spp as u64), &hidden));
@@ -115,64 +230,49 @@ fn measure_scene(name: &'static str, bar: &ProgressBar) -> Result<SceneResult, B
         });
     }
     bar.inc(1);
-    let px = scene.camera.pixels() as f64;
-    let run_lobes = |o: &lobes::Options| -> Result<(Point, crate::scene::image::Image), String> {
-        // The best of three runs: one render is a few milliseconds.
-        let mut best = f64::INFINITY;
-        let mut last = None;
-        for _ in 0..3 {
-            let ((img, counts), s) = timed(|| lobes::render(&scene, o, &hidden));
+    let (curve_settings, variant_settings) = if method == "hvl" {
+        hvl_settings(&scene)
+    } else {
+        lobes_settings(&scene)
+    };
+    let measure = |st: &Setting<'_>| -> Result<(Point, Image), String> {
+        // The best of three runs when one takes under 0.2 s.
+        let (mut last, mut best) = timed(|| (st.render)());
+        for _ in 0..2 {
+            if best >= 0.2 {
+                break;
+            }
+            let (r, s) = timed(|| (st.render)());
             best = best.min(s);
-            last = Some((img, counts));
+            last = r;
         }
-        let (img, counts) = last.expect("three runs");
+        let (img, products) = last;
         Ok((
             Point {
-                setting: format!("t = {:.0e}", o.threshold),
+                setting: st.label.clone(),
                 seconds: best,
                 metrics: compare(&img)?,
-                products_per_pixel: Some(counts.computed as f64 / px),
+                products_per_pixel: products,
             },
             img,
         ))
     };
-    let mut lobes_curve = Vec::new();
+    let mut curve = Vec::new();
     let mut default_img = None;
-    let default = lobes::Options::default();
-    for &t in THRESHOLDS {
-        let o = lobes::Options {
-            threshold: t,
-            ..default
-        };
-        let (p, img) = run_lobes(&o)?;
-        if t == default.threshold {
+    for st in &curve_settings {
+        let (p, img) = measure(st)?;
+        if st.default {
             default_img = Some((p.clone(), img));
         }
-        lobes_curve.push(p);
+        curve.push(p);
     }
-    let (mut lobes_l2, _) = run_lobes(&lobes::Options {
-        fit: CapFit::L2,
-        ..default
-    })?;
-    lobes_l2.setting = format!("L2 fit, t = {:.0e}", default.threshold);
-    let (mut lobes_per, _) = run_lobes(&lobes::Options {
-        visibility: lobes::Visibility::PerOccluder,
-        ..default
-    })?;
-    lobes_per.setting = format!("one lobe per occluder, t = {:.0e}", default.threshold);
+    let variants = variant_settings
+        .iter()
+        .map(|st| measure(st).map(|(p, _)| p))
+        .collect::<Result<Vec<_>, _>>()?;
     bar.inc(1);
-    let (dp, dimg) = default_img.ok_or("the default threshold is on the curve")?;
+    let (dp, dimg) = default_img.ok_or("the default setting is on the curve")?;
     let equal_error_ratio = path_seconds_at(&path_curve, dp.metrics.mean_abs_over_max) / dp.seconds;
-    let png = |img: &crate::scene::image::Image| -> Result<Vec<u8>, String> {
-        let mut bytes = Vec::new();
-        img.to_rgb8(0.0)
-            .write_to(
-                &mut std::io::Cursor::new(&mut bytes),
-                image::ImageFormat::Png,
-            )
-            .map_err(|e| e.to_string())?;
-        Ok(bytes)
-    };
     let diff = metrics::difference_image(
         &scene,
         &dimg,
@@ -182,18 +282,19 @@ fn measure_scene(name: &'static str, bar: &ProgressBar) -> Result<SceneResult, B
     );
     let files = vec![
         (format!("scene_{name}_path.png"), png(&reference.image)?),
-        (format!("scene_{name}_lobes.png"), png(&dimg)?),
-        (format!("scene_{name}_lobes_diff.png"), png(&diff)?),
+        (format!("scene_{name}_{method}.png"), png(&dimg)?),
+        (format!("scene_{name}_{method}_diff.png"), png(&diff)?),
     ];
     Ok(SceneResult {
         name,
+        method,
+        bounces,
         width: scene.camera.width,
         height: scene.camera.height,
         reference_seconds,
         path: path_curve,
-        lobes: lobes_curve,
-        lobes_l2,
-        lobes_per,
+        curve,
+        variants,
         equal_error_ratio,
         files,
     })
@@ -223,51 +324,61 @@ fn plot(r: &SceneResult) -> String {
         Axis::new("mean |diff| / max radiance", Scale::Log),
         vec![
             Series::line("path tracer (spp)", pts(&r.path)),
-            Series::line("lobes (threshold)", pts(&r.lobes)).wide(),
-            Series::dots("lobes, L2 cap fit", pts(std::slice::from_ref(&r.lobes_l2))),
-            Series::dots(
-                "lobes, one lobe per occluder",
-                pts(std::slice::from_ref(&r.lobes_per)),
-            ),
+            Series::line(r.method, pts(&r.curve)).wide(),
+            Series::dots(format!("{}, variants", r.method), pts(&r.variants)),
         ],
     )
     .svg()
 }
 
+/// The scenes measured: (scene, method, bounces of the reference).
+pub const SCENES: &[(&str, &str, u32)] = &[
+    ("lobes", "lobes", 0),
+    ("cluster", "lobes", 0),
+    ("room", "hvl", 1),
+];
+
 /// The report section (see the module docs).
 pub fn section(_opts: &Options) -> Result<Section, Box<dyn Error>> {
-    let bar = ProgressBar::new(6);
+    let bar = ProgressBar::new(3 * SCENES.len() as u64);
     bar.set_message("scenes");
-    let results = ["lobes", "cluster"]
-        .into_iter()
-        .map(|n| measure_scene(n, &bar))
+    let results = SCENES
+        .iter()
+        .map(|&(n, m, b)| measure_scene(n, m, b, &bar))
         .collect::<Result<Vec<_>, _>>()?;
     bar.finish_and_clear();
-    let default_t = lobes::Options::default().threshold;
     let mut summary = String::new();
     let mut html = String::new();
     let mut files = Vec::new();
     let mut data = Vec::new();
     writeln!(
         html,
-        "<p>Built-in scenes at {WIDTH} columns, direct light. Reference: the path tracer at \
-         {REFERENCE_SPP} samples per pixel. Errors over shaded, non-silhouette pixels (see the \
-         README, \"Errors\"); times are whole renders on this machine's thread pool.</p>"
+        "<p>Built-in scenes at {WIDTH} columns. Reference: the path tracer at {REFERENCE_SPP} \
+         samples per pixel (direct light; one bounce for <code>room</code>). Errors over shaded, \
+         non-silhouette pixels (see the README, \"Errors\"); times are whole renders on this \
+         machine's thread pool, the best of three for the methods.</p>"
     )?;
     for r in &results {
         let d = r
-            .lobes
+            .curve
             .iter()
-            .find(|p| p.setting == format!("t = {default_t:.0e}"))
-            .ok_or("default point")?;
+            .find(|p| p.setting.contains(&default_label(r.method)))
+            .unwrap_or(&r.curve[0]);
+        let variants: Vec<String> = r
+            .variants
+            .iter()
+            .map(|v| format!("{} {:.2e}", v.setting, v.metrics.mean_abs_over_max))
+            .collect();
         writeln!(
             summary,
-            "  {}: lobes {:.2e} of max radiance in {:.1} ms (L2 fit {:.2e}, one lobe per occluder {:.2e}); path tracer {:.2e} at 1 spp, {:.2e} at 64 spp; reference noise {:.1e}; equal-error cost ratio {:.1}×",
+            "  {} ({}, {} bounce(s)): {:.2e} of max radiance, RMSE {:.4}, in {:.1} ms ({}); path tracer {:.2e} at 1 spp, {:.2e} at 64 spp; reference noise {:.1e}; equal-error cost ratio {:.1}×",
             r.name,
+            r.method,
+            r.bounces,
             d.metrics.mean_abs_over_max,
+            d.metrics.rmse,
             d.seconds * 1e3,
-            r.lobes_l2.metrics.mean_abs_over_max,
-            r.lobes_per.metrics.mean_abs_over_max,
+            variants.join("; "),
             r.path[0].metrics.mean_abs_over_max,
             r.path[r.path.len() - 1].metrics.mean_abs_over_max,
             d.metrics.reference_noise_over_max,
@@ -275,28 +386,34 @@ pub fn section(_opts: &Options) -> Result<Section, Box<dyn Error>> {
         )?;
         writeln!(
             html,
-            "<h3>{}</h3><p>{}×{}; reference {:.1} s. The path tracer needs {:.1}× the time of \
-             <code>lobes</code> (t = {default_t:.0e}) for its error.</p>\
-             <p><img src=\"scene_{0}_path.png\" alt=\"path\"> <img src=\"scene_{0}_lobes.png\" alt=\"lobes\"> \
-             <img src=\"scene_{0}_lobes_diff.png\" alt=\"difference\"> (reference, lobes, difference: red brighter, blue darker, full at 5 % of the maximum)</p>\
-             <img src=\"scene_{0}.svg\" alt=\"curve\">",
-            r.name, r.width, r.height, r.reference_seconds, r.equal_error_ratio
+            "<h3>{} ({})</h3><p>{}×{}; reference {:.1} s. The path tracer needs {:.1}× the time of \
+             <code>{1}</code> ({}) for its error.</p>\
+             <p><img src=\"scene_{0}_path.png\" alt=\"path\"> <img src=\"scene_{0}_{1}.png\" alt=\"{1}\"> \
+             <img src=\"scene_{0}_{1}_diff.png\" alt=\"difference\"> (reference, {1}, difference: red brighter, \
+             blue darker, full at 5 % of the maximum)</p><img src=\"scene_{0}.svg\" alt=\"curve\">",
+            r.name,
+            r.method,
+            r.width,
+            r.height,
+            r.reference_seconds,
+            r.equal_error_ratio,
+            d.setting
         )?;
-        html.push_str("<table><tr><th>method</th><th>setting</th><th>s</th><th>mean |diff|/max</th><th>rel L2</th><th>PSNR dB</th><th>SSIM</th><th>products/px</th></tr>");
+        html.push_str("<table><tr><th>method</th><th>setting</th><th>s</th><th>mean |diff|/max</th><th>rel L2</th><th>RMSE</th><th>PSNR dB</th><th>SSIM</th><th>products/px</th></tr>");
         for (m, p) in r
             .path
             .iter()
             .map(|p| ("path", p))
-            .chain(r.lobes.iter().map(|p| ("lobes", p)))
-            .chain([("lobes", &r.lobes_l2), ("lobes", &r.lobes_per)])
+            .chain(r.curve.iter().chain(&r.variants).map(|p| (r.method, p)))
         {
             write!(
                 html,
-                "<tr><td>{m}</td><td>{}</td><td>{:.4}</td><td>{:.2e}</td><td>{:.2e}</td><td>{:.1}</td><td>{:.4}</td><td>{}</td></tr>",
+                "<tr><td>{m}</td><td>{}</td><td>{:.4}</td><td>{:.2e}</td><td>{:.2e}</td><td>{:.4}</td><td>{:.1}</td><td>{:.4}</td><td>{}</td></tr>",
                 p.setting,
                 p.seconds,
                 p.metrics.mean_abs_over_max,
                 p.metrics.rel_l2,
+                p.metrics.rmse,
                 p.metrics.psnr_db,
                 p.metrics.ssim,
                 p.products_per_pixel
@@ -308,14 +425,16 @@ pub fn section(_opts: &Options) -> Result<Section, Box<dyn Error>> {
         files.push((format!("scene_{}.svg", r.name), plot(r).into_bytes()));
         data.push(json!({
             "scene": r.name,
+            "method": r.method,
+            "bounces": r.bounces,
             "width": r.width,
             "height": r.height,
             "reference_spp": REFERENCE_SPP,
             "reference_seconds": r.reference_seconds,
             "path": r.path.iter().map(point_json).collect::<Vec<_>>(),
-            "lobes": r.lobes.iter().map(point_json).collect::<Vec<_>>(),
-            "lobes_l2_fit": point_json(&r.lobes_l2),
-            "lobes_per_occluder": point_json(&r.lobes_per),
+            "curve": r.curve.iter().map(point_json).collect::<Vec<_>>(),
+            "default": d.setting,
+            "variants": r.variants.iter().map(point_json).collect::<Vec<_>>(),
             "equal_error_cost_ratio": r.equal_error_ratio,
         }));
     }
@@ -327,4 +446,14 @@ pub fn section(_opts: &Options) -> Result<Section, Box<dyn Error>> {
         data: json!({ "scenes": data }),
         files,
     })
+}
+
+/// The label of a method's default setting on its curve.
+fn default_label(method: &str) -> String {
+    if method == "hvl" {
+        let side = hvl::Options::default().side;
+        format!("{} HVLs", 6 * side * side)
+    } else {
+        format!("t = {:.0e}", lobes::Options::default().threshold)
+    }
 }

@@ -19,6 +19,7 @@
 pub mod builtin;
 pub mod file;
 pub mod geom;
+pub mod hvl;
 pub mod image;
 pub mod light;
 pub mod lobes;

@@ -20,6 +20,8 @@ pub enum Method {
     Path,
     /// Cosine lobes (direct light from spherical lights).
     Lobes,
+    /// Harmonics virtual lights (one indirect bounce) plus the direct light of `lobes`.
+    Hvl,
 }
 
 impl Method {
@@ -28,10 +30,13 @@ impl Method {
         match s {
             "path" => Ok(Method::Path),
             "lobes" => Ok(Method::Lobes),
-            "rsl" | "hvl" => Err(format!(
-                "method {s:?} is not available yet (available: path, lobes)"
+            "hvl" => Ok(Method::Hvl),
+            "rsl" => Err(format!(
+                "method {s:?} is not available yet (available: path, lobes, hvl)"
             )),
-            _ => Err(format!("unknown method {s:?} (available: path, lobes)")),
+            _ => Err(format!(
+                "unknown method {s:?} (available: path, lobes, hvl)"
+            )),
         }
     }
 
@@ -40,6 +45,7 @@ impl Method {
         match self {
             Method::Path => "path",
             Method::Lobes => "lobes",
+            Method::Hvl => "hvl",
         }
     }
 }
@@ -125,7 +131,7 @@ pub fn plan(scene: &Scene, o: &Options) -> Result<(Vec<PlanItem>, lobes::Options
                 reason: "indirect bounces (0: direct light only)".into(),
             });
         }
-        Method::Lobes => {
+        Method::Lobes | Method::Hvl => {
             if scene.environment.is_some() {
                 return Err(
                     "method lobes lights with spherical lights only; this scene has an \
@@ -221,6 +227,14 @@ pub fn run(scene: &Scene, scene_name: &str, o: &Options) -> Result<Outcome, Stri
                 }),
             )
         }
+        Method::Hvl => {
+            let ho = super::hvl::Options {
+                direct: lobe_opts,
+                ..Default::default()
+            };
+            let (img, count) = super::hvl::render(scene, &ho, &b);
+            (img, None, json!({ "hvls": count }))
+        }
     };
     let seconds = start.elapsed().as_secs_f64();
     b.finish_and_clear();
@@ -239,7 +253,7 @@ pub fn run(scene: &Scene, scene_name: &str, o: &Options) -> Result<Outcome, Stri
     let px = scene.camera.pixels() as f64;
     let samples = match o.method {
         Method::Path => px * o.spp.max(1) as f64,
-        Method::Lobes => px,
+        Method::Lobes | Method::Hvl => px,
     };
     let json = json!({
         "scene": scene_name,

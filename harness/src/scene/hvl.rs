@@ -1,0 +1,257 @@
+//! The `hvl` method (HVL paper, section 5.2): one bounce of indirect light from harmonics
+//! virtual lights placed from a reflective shadow map of each spherical light, plus the
+//! direct light of the `lobes` method.
+//!
+//! **Placement.** A sphere of radius `r` and radiance `L` radiates the intensity
+//! `I = L·πr²` in every direction (its projected area is `πr²` from anywhere), so a cube
+//! map of `6·s²` texels around its centre (field of view 90° per face) sends the power
+//! `Φ = I·Ω_texel` (the texel's exact solid angle) along each texel's
+//! centre ray; the first surface hit `y` (normal `n_y` toward the light) receives it and
+//! becomes an HVL of radius `r2 = k·t·tan γ` (eq. 24–25, `t` the ray's length, `γ` the
+//! diagonal angle of an `s × s` face of field of view 90°, `k = 1`). Rays that escape or
+//! hit another light place nothing.
+//!
+//! **Emission and reception** (eq. 19–22, `steradian_core::sh::hvl::contribution`): an HVL
+//! reflects its surface's *diffuse* albedo (Lambertian emission, exact in one band); a
+//! receiver's diffuse albedo times the 5-band Lambert table. Both are linear, so the
+//! scalar contribution of a unit HVL is computed once per pair and scaled in RGB by the
+//! light's radiance and the two albedos. Glossy parts are not carried by the indirect
+//! term (a BRDF table per material would be: not built here). The paper does not test
+//! visibility between an HVL and the receiver; here a shadow ray per pair does by default
+//! ([`Options::visibility`]), which the harness measures on the `room` scene.
+
+use std::f64::consts::FRAC_PI_2;
+
+use glam::DVec3;
+use indicatif::ProgressBar;
+use rayon::prelude::*;
+use steradian_core::sh::{brdf, hvl as core_hvl};
+
+use super::image::Image;
+use super::lobes::{self, ShadingPoint};
+use super::{Kind, Ray, Rgb, Scene};
+
+/// Settings of the `hvl` method.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Options {
+    /// Cube-map face side of each light's reflective shadow map (`6·side²` rays).
+    pub side: usize,
+    /// The `lobes` method's settings for the direct light.
+    pub direct: lobes::Options,
+    /// Test each HVL–receiver pair with a shadow ray (the paper does not: `false`).
+    pub visibility: bool,
+}
+
+impl Default for Options {
+    fn default() -> Self {
+        Options {
+            side: 8,
+            direct: lobes::Options::default(),
+            visibility: true,
+        }
+    }
+}
+
+/// One placed HVL: the core light (unit power) and its RGB power × albedo.
+#[derive(Clone, Copy, Debug)]
+pub struct Placed {
+    /// The core HVL with unit power.
+    pub hvl: core_hvl::Hvl,
+    /// `Φ·albedo` in RGB: what multiplies the unit contribution.
+    pub weight: Rgb,
+}
+
+/// The HVLs of every spherical light.
+pub fn place(scene: &Scene, side: usize) -> Vec<Placed> {
+    let side = side.max(1);
+    let m = (side * side) as u32;
+    let du = 2.0 / side as f64;
+    let mut out = Vec::new();
+    for light in &scene.lights {
+        let intensity = light
+            .radiance
+            .map(|l| l * std::f64::consts::PI * light.radius.powi(2));
+        for face in 0..6 {
+            let (axis, t, b) = face_frame(face);
+            for i in 0..side {
+                for j in 0..side {
+                    let (u, v) = (-1.0 + (i as f64 + 0.5) * du, -1.0 + (j as f64 + 0.5) * du);
+                    let omega = texel_solid_angle(u - du / 2.0, v - du / 2.0, du);
+                    let d = (axis + u * t + v * b).normalize();
+                    let ray = Ray {
+                        o: light.center + d * light.radius * (1.0 + 1e-9),
+                        d,
+                    };
+                    let Some(hit) = scene.intersect(&ray, 0.0, f64::INFINITY) else {
+                        continue;
+                    };
+                    let obj = scene.objects[hit.object];
+                    let Kind::Surface(mi) = obj.kind else {
+                        continue;
+                    };
+                    let y = ray.o + hit.t * d;
+                    let mut n = obj.shape.normal(y);
+                    if n.dot(d) > 0.0 {
+                        n = -n;
+                    }
+                    let dist = (y - light.center).length();
+                    let r = core_hvl::radius_from_fov(dist as f32, FRAC_PI_2 as f32, m, 1.0);
+                    let Ok(h) = core_hvl::Hvl::new(
+                        y.as_vec3(),
+                        n.as_vec3(),
+                        (-d).as_vec3(),
+                        r.max(1e-6),
+                        1.0,
+                    ) else {
+                        continue;
+                    };
+                    let albedo = scene.materials[mi].diffuse();
+                    let mut w = [0.0; 3];
+                    for c in 0..3 {
+                        w[c] = intensity[c] * omega * albedo[c];
+                    }
+                    out.push(Placed { hvl: h, weight: w });
+                }
+            }
+        }
+    }
+    out
+}
+
+/// The exact solid angle of the cube-face texel `[u, u + du] × [v, v + du]` at unit
+/// distance: `F(u₁, v₁) − F(u₀, v₁) − F(u₁, v₀) + F(u₀, v₀)`, `F = atan(uv/√(1 + u² + v²))`
+/// (the solid angle of the rectangle from the face centre to `(u, v)`), so a face sums to
+/// `4·F(1, 1) = 4π/6` exactly.
+fn texel_solid_angle(u: f64, v: f64, du: f64) -> f64 {
+    let f = |a: f64, b: f64| (a * b / (1.0 + a * a + b * b).sqrt()).atan();
+    f(u + du, v + du) - f(u, v + du) - f(u + du, v) + f(u, v)
+}
+
+/// Axis, and two tangents, of cube face `f` (±x, ±y, ±z).
+fn face_frame(f: usize) -> (DVec3, DVec3, DVec3) {
+    let axis = match f {
+        0 => DVec3::X,
+        1 => -DVec3::X,
+        2 => DVec3::Y,
+        3 => -DVec3::Y,
+        4 => DVec3::Z,
+        _ => -DVec3::Z,
+    };
+    let (t, b) = super::material::basis(axis);
+    (axis, t, b)
+}
+
+/// The indirect radiance at a shading point from the placed HVLs.
+pub fn indirect(
+    scene: &Scene,
+    p: &ShadingPoint,
+    hvls: &[Placed],
+    visibility: bool,
+    scratch: &mut [f32],
+) -> Rgb {
+    let table = brdf::lambert();
+    let bands = table.bands();
+    let albedo = scene.materials[p.material].diffuse();
+    if albedo.iter().all(|&a| a == 0.0) {
+        return [0.0; 3];
+    }
+    let Ok(frame) = brdf::view_frame(p.n.as_vec3(), p.wo.as_vec3()) else {
+        return [0.0; 3];
+    };
+    let theta = frame.to_local(p.wo.as_vec3()).z.clamp(-1.0, 1.0).acos();
+    let mut coeffs = vec![0.0f32; bands * bands];
+    if table
+        .lookup_into(brdf::Part::WithCosine, theta, bands, &mut coeffs)
+        .is_err()
+    {
+        return [0.0; 3];
+    }
+    let rx = core_hvl::Receiver {
+        point: p.x.as_vec3(),
+        frame,
+        coeffs: &coeffs,
+    };
+    let emission = core_hvl::lambert_emission(1.0);
+    let origin = p.x + p.n * (1e-7 * (1.0 + p.x.abs().max_element()));
+    let mut acc = [0.0f64; 3];
+    for h in hvls {
+        let c = core_hvl::contribution(
+            &h.hvl,
+            &emission,
+            &rx,
+            core_hvl::Horizon::Smoothstep,
+            scratch,
+        )
+        .unwrap_or(0.0) as f64;
+        if c > 0.0 && visibility {
+            let to = h.hvl.position().as_dvec3() - origin;
+            let d = to.length();
+            let ray = Ray {
+                o: origin,
+                d: to / d,
+            };
+            if scene.occluded(&ray, 0.0, d * (1.0 - 1e-4)) {
+                continue;
+            }
+        }
+        if c > 0.0 {
+            for (a, w) in acc.iter_mut().zip(h.weight) {
+                *a += c * w;
+            }
+        }
+    }
+    [acc[0] * albedo[0], acc[1] * albedo[1], acc[2] * albedo[2]]
+}
+
+/// Direct light by the `lobes` method plus one bounce from HVLs, one pixel-centre sample
+/// per pixel; returns the image and the HVL count.
+pub fn render(scene: &Scene, o: &Options, bar: &ProgressBar) -> (Image, usize) {
+    let hvls = place(scene, o.side);
+    let cam = scene.camera;
+    let (w, h) = (cam.width as usize, cam.height as usize);
+    let bands = brdf::lambert().bands();
+    let rows: Vec<Vec<Rgb>> = (0..h)
+        .into_par_iter()
+        .map(|j| {
+            let mut counts = Default::default();
+            let mut scratch = vec![0.0f32; bands * bands];
+            let row = (0..w)
+                .map(|i| {
+                    let ray = cam.centre_ray(i as u32, j as u32);
+                    let Some(hit) = scene.intersect(&ray, 0.0, f64::INFINITY) else {
+                        return scene.environment_radiance(ray.d);
+                    };
+                    let obj = scene.objects[hit.object];
+                    match obj.kind {
+                        Kind::Light(li) => scene.lights[li].radiance,
+                        Kind::Surface(mi) => {
+                            let x = ray.o + hit.t * ray.d;
+                            let wo = -ray.d;
+                            let mut n = obj.shape.normal(x);
+                            if n.dot(wo) < 0.0 {
+                                n = -n;
+                            }
+                            let p = ShadingPoint {
+                                object: hit.object,
+                                material: mi,
+                                x,
+                                n,
+                                wo,
+                            };
+                            let d = lobes::shade(scene, &p, &o.direct, &mut counts);
+                            let ind = indirect(scene, &p, &hvls, o.visibility, &mut scratch);
+                            [d[0] + ind[0], d[1] + ind[1], d[2] + ind[2]]
+                        }
+                    }
+                })
+                .collect();
+            bar.inc(1);
+            row
+        })
+        .collect();
+    let mut img = Image::new(w, h);
+    for (j, row) in rows.into_iter().enumerate() {
+        img.data[j * w..(j + 1) * w].copy_from_slice(&row);
+    }
+    (img, hvls.len())
+}
