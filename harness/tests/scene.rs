@@ -441,3 +441,31 @@ fn hvl_method_against_the_path_tracer_on_a_small_room() {
     assert!(with.mean_abs_over_max < direct.mean_abs_over_max);
     assert!(with.rmse < direct.rmse);
 }
+
+/// The `rsl` method (K = 30) on a small `environment` scene against the path tracer (direct
+/// light): relative L2 within the bound measured here. The RSL paper's 0.35 % is not met:
+/// the floor is within about 0.5 %, the glossy and diffuse spheres are 3 % too bright.
+#[test]
+fn rsl_method_against_the_path_tracer_on_a_small_environment_scene() {
+    use steradian_harness::scene::rsl;
+    let mut s = Scene::load("builtin:environment").unwrap();
+    s.camera = s.camera.resized(48).unwrap();
+    let hidden = ProgressBar::hidden();
+    let reference = path::render(
+        &s,
+        &path::Settings {
+            spp: 512,
+            bounces: 0,
+            seed: 1,
+        },
+        &hidden,
+    );
+    let img = rsl::render(&s, &rsl::Options::default(), &hidden).unwrap();
+    let m = metrics::compare(&s, &img, &reference.image, Some(&reference.stderr), 0.0).unwrap();
+    eprintln!("rsl {m:?}");
+    assert!(m.rel_l2 < 0.035, "{m:?}");
+    assert!(
+        m.mean_abs_over_max < 0.012 + 4.0 * m.reference_noise_over_max,
+        "{m:?}"
+    );
+}

@@ -9,7 +9,8 @@
 //! samples. The `lobes` method's curve is its pruning threshold, with the L2 cap fit and
 //! one lobe per occluder (instead of the default energy-preserving fit and quadtree mask)
 //! beside it; the `hvl` method's curve is its HVL count, with the paper's choice of no
-//! HVL visibility and the direct light alone beside it. Times
+//! HVL visibility and the direct light alone beside it; the `rsl` method's is its number
+//! of square lights `K`. Times
 //! are wall-clock seconds of whole renders on this machine's thread pool, both sides alike
 //! (the best of three for renders under 0.2 s).
 //! "Equal-error cost": the path tracer's time at the method's error, interpolated on its
@@ -28,10 +29,10 @@ use super::plot::{Axis, Chart, Pt, Scale, Series};
 use super::section::Section;
 use crate::scene::image::Image;
 use crate::scene::metrics::{self, Metrics};
-use crate::scene::{Scene, hvl, lobes, path};
+use crate::scene::{Scene, hvl, lobes, path, rsl};
 
 /// Image width of the section's renders (the height follows each scene's aspect ratio).
-pub const WIDTH: u32 = 128;
+pub const WIDTH: u32 = 96;
 /// Samples per pixel of the reference.
 pub const REFERENCE_SPP: u32 = 512;
 /// The path tracer's own curve.
@@ -40,6 +41,9 @@ const PATH_SPP: &[u32] = &[1, 2, 4, 8, 16, 64];
 const THRESHOLDS: &[f32] = &[0.0, 1e-4, 1e-3, 1e-2, 5e-2];
 /// Reflective-shadow-map face sides of the `hvl` curve.
 const HVL_SIDES: &[usize] = &[2, 4, 8, 12];
+/// Square-light counts of the `rsl` curve (one point: its cost is the per-point
+/// visibility tables, whatever `K`; the report's `shade` section measures `K`).
+const RSL_KS: &[usize] = &[30];
 
 /// One point of a curve.
 #[derive(Clone, Debug)]
@@ -193,6 +197,25 @@ fn hvl_settings(scene: &Scene) -> (Vec<Setting<'_>>, Vec<Setting<'_>>) {
     (curve, variants)
 }
 
+fn rsl_settings(scene: &Scene) -> (Vec<Setting<'_>>, Vec<Setting<'_>>) {
+    let d = rsl::Options::default();
+    let curve = RSL_KS
+        .iter()
+        .map(|&k| Setting {
+            label: format!("K = {k}"),
+            render: Box::new(move || {
+                let img = rsl::render(scene, &rsl::Options { k, ..d }, &ProgressBar::hidden())
+                    .unwrap_or_else(|_| {
+                        Image::new(scene.camera.width as usize, scene.camera.height as usize)
+                    });
+                (img, None)
+            }),
+            default: k == d.k,
+        })
+        .collect();
+    (curve, Vec::new())
+}
+
 fn png(img: &Image) -> Result<Vec<u8>, String> {
     let mut bytes = Vec::new();
     img.to_rgb8(0.0)
@@ -230,10 +253,10 @@ fn measure_scene(
         });
     }
     bar.inc(1);
-    let (curve_settings, variant_settings) = if method == "hvl" {
-        hvl_settings(&scene)
-    } else {
-        lobes_settings(&scene)
+    let (curve_settings, variant_settings) = match method {
+        "hvl" => hvl_settings(&scene),
+        "rsl" => rsl_settings(&scene),
+        _ => lobes_settings(&scene),
     };
     let measure = |st: &Setting<'_>| -> Result<(Point, Image), String> {
         // The best of three runs when one takes under 0.2 s.
@@ -336,6 +359,7 @@ pub const SCENES: &[(&str, &str, u32)] = &[
     ("lobes", "lobes", 0),
     ("cluster", "lobes", 0),
     ("room", "hvl", 1),
+    ("environment", "rsl", 0),
 ];
 
 /// The report section (see the module docs).
@@ -378,7 +402,11 @@ pub fn section(_opts: &Options) -> Result<Section, Box<dyn Error>> {
             d.metrics.mean_abs_over_max,
             d.metrics.rmse,
             d.seconds * 1e3,
-            variants.join("; "),
+            if variants.is_empty() {
+                "no variants".to_string()
+            } else {
+                variants.join("; ")
+            },
             r.path[0].metrics.mean_abs_over_max,
             r.path[r.path.len() - 1].metrics.mean_abs_over_max,
             d.metrics.reference_noise_over_max,
@@ -450,10 +478,12 @@ pub fn section(_opts: &Options) -> Result<Section, Box<dyn Error>> {
 
 /// The label of a method's default setting on its curve.
 fn default_label(method: &str) -> String {
-    if method == "hvl" {
-        let side = hvl::Options::default().side;
-        format!("{} HVLs", 6 * side * side)
-    } else {
-        format!("t = {:.0e}", lobes::Options::default().threshold)
+    match method {
+        "hvl" => {
+            let side = hvl::Options::default().side;
+            format!("{} HVLs", 6 * side * side)
+        }
+        "rsl" => format!("K = {}", rsl::Options::default().k),
+        _ => format!("t = {:.0e}", lobes::Options::default().threshold),
     }
 }

@@ -27,6 +27,7 @@ pub mod material;
 pub mod metrics;
 pub mod path;
 pub mod render;
+pub mod rsl;
 
 use std::path::Path;
 

@@ -22,6 +22,8 @@ pub enum Method {
     Lobes,
     /// Harmonics virtual lights (one indirect bounce) plus the direct light of `lobes`.
     Hvl,
+    /// Rotatable square lights: environment lighting.
+    Rsl,
 }
 
 impl Method {
@@ -31,11 +33,9 @@ impl Method {
             "path" => Ok(Method::Path),
             "lobes" => Ok(Method::Lobes),
             "hvl" => Ok(Method::Hvl),
-            "rsl" => Err(format!(
-                "method {s:?} is not available yet (available: path, lobes, hvl)"
-            )),
+            "rsl" => Ok(Method::Rsl),
             _ => Err(format!(
-                "unknown method {s:?} (available: path, lobes, hvl)"
+                "unknown method {s:?} (available: path, lobes, hvl, rsl)"
             )),
         }
     }
@@ -46,6 +46,7 @@ impl Method {
             Method::Path => "path",
             Method::Lobes => "lobes",
             Method::Hvl => "hvl",
+            Method::Rsl => "rsl",
         }
     }
 }
@@ -130,6 +131,42 @@ pub fn plan(scene: &Scene, o: &Options) -> Result<(Vec<PlanItem>, lobes::Options
                 value: json!(o.bounces),
                 reason: "indirect bounces (0: direct light only)".into(),
             });
+        }
+        Method::Rsl => {
+            if scene.environment.is_none() {
+                return Err("method rsl lights with an environment; this scene has none".into());
+            }
+            let r = super::rsl::Options::default();
+            p.push(PlanItem {
+                item: "rsls".into(),
+                value: json!(r.k),
+                reason: format!(
+                    "K square lights from a 6 × {}² cube map (the RSL paper's K = 30)",
+                    r.face
+                ),
+            });
+            p.push(PlanItem {
+                item: "brdf_sats".into(),
+                value: json!(r.sat_target),
+                reason: "one Lambert SAT and one per distinct Phong exponent, fitted to this \
+                         target; Lafortune lobes are not carried"
+                    .into(),
+            });
+            p.push(PlanItem {
+                item: "visibility".into(),
+                value: json!(format!(
+                    "{0}×{0} coverage → moment tables per point",
+                    r.vis_side
+                )),
+                reason: "caps of the other spheres and the planes the point is not on".into(),
+            });
+            if !scene.lights.is_empty() {
+                p.push(PlanItem {
+                    item: "spherical_lights".into(),
+                    value: json!(scene.lights.len()),
+                    reason: "seen and occluding only: the lobes method lights with them".into(),
+                });
+            }
         }
         Method::Lobes | Method::Hvl => {
             if scene.environment.is_some() {
@@ -227,6 +264,14 @@ pub fn run(scene: &Scene, scene_name: &str, o: &Options) -> Result<Outcome, Stri
                 }),
             )
         }
+        Method::Rsl => {
+            let img = super::rsl::render(scene, &super::rsl::Options::default(), &b)?;
+            (
+                img,
+                None,
+                json!({ "rsls": super::rsl::Options::default().k }),
+            )
+        }
         Method::Hvl => {
             let ho = super::hvl::Options {
                 direct: lobe_opts,
@@ -253,7 +298,7 @@ pub fn run(scene: &Scene, scene_name: &str, o: &Options) -> Result<Outcome, Stri
     let px = scene.camera.pixels() as f64;
     let samples = match o.method {
         Method::Path => px * o.spp.max(1) as f64,
-        Method::Lobes | Method::Hvl => px,
+        Method::Lobes | Method::Hvl | Method::Rsl => px,
     };
     let json = json!({
         "scene": scene_name,
