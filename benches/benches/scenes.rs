@@ -9,8 +9,8 @@ use std::hint::black_box;
 
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use steradian_harness::rng::Rng;
-use steradian_harness::scene::lobes::{self, ShadingPoint, Visibility};
-use steradian_harness::scene::{Kind, Ray, Scene, path};
+use steradian_harness::scene::lobes::{self, Visibility};
+use steradian_harness::scene::{Ray, Scene, Seen, ShadingPoint, path};
 
 /// The shading points of a 48-column render whose centre ray meets a surface, with the rays.
 fn points(scene: &Scene) -> Vec<(Ray, ShadingPoint)> {
@@ -19,25 +19,8 @@ fn points(scene: &Scene) -> Vec<(Ray, ShadingPoint)> {
     for j in 0..cam.height {
         for i in 0..cam.width {
             let ray = cam.centre_ray(i, j);
-            if let Some(hit) = scene.intersect(&ray, 0.0, f64::INFINITY) {
-                let obj = scene.objects[hit.object];
-                if let Kind::Surface(m) = obj.kind {
-                    let x = ray.o + hit.t * ray.d;
-                    let mut n = obj.shape.normal(x);
-                    if n.dot(ray.d) > 0.0 {
-                        n = -n;
-                    }
-                    out.push((
-                        ray,
-                        ShadingPoint {
-                            object: hit.object,
-                            material: m,
-                            x,
-                            n,
-                            wo: -ray.d,
-                        },
-                    ));
-                }
+            if let Seen::Surface(p) = scene.see(&ray) {
+                out.push((ray, p));
             }
         }
     }

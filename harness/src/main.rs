@@ -107,12 +107,12 @@ fn render(
     if let Some(w) = width {
         s.camera = s.camera.resized(w).map_err(|e| format!("--width: {e}"))?;
     }
-    let (plan, _) = scene::render::plan(&s, &o)?;
+    let plan = scene::render::plan(&s, &o)?;
     eprintln!("plan ({}):", o.method.name());
-    for p in &plan {
+    for p in &plan.items {
         eprintln!("  {} = {}: {}", p.item, p.value, p.reason);
     }
-    let out = scene::render::run(&s, spec, &o)?;
+    let out = scene::render::run(&s, spec, &o, &plan)?;
     eprintln!(
         "{}: {}×{} in {:.2} s, written to {}",
         o.method.name(),

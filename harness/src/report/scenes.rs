@@ -240,8 +240,9 @@ fn measure_scene(
     let (reference, reference_seconds) =
         timed(|| path::render(&scene, &settings(REFERENCE_SPP, 1), &hidden));
     bar.inc(1);
+    let class = metrics::classify(&scene);
     let compare =
-        |img: &Image| metrics::compare(&scene, img, &reference.image, Some(&reference.stderr), 0.0);
+        |img: &Image| metrics::compare(&class, img, &reference.image, Some(&reference.stderr), 0.0);
     let mut path_curve = Vec::new();
     for &spp in PATH_SPP {
         let (out, s) = timed(|| path::render(&scene, &settings(spp, 1000 + spp as u64), &hidden));
@@ -297,7 +298,7 @@ fn measure_scene(
     let (dp, dimg) = default_img.ok_or("the default setting is on the curve")?;
     let equal_error_ratio = path_seconds_at(&path_curve, dp.metrics.mean_abs_over_max) / dp.seconds;
     let diff = metrics::difference_image(
-        &scene,
+        &class,
         &dimg,
         &reference.image,
         dp.metrics.max_radiance,

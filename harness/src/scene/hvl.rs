@@ -24,12 +24,11 @@ use std::f64::consts::FRAC_PI_2;
 
 use glam::DVec3;
 use indicatif::ProgressBar;
-use rayon::prelude::*;
+use steradian_core::lobe::sum::ProductCounts;
 use steradian_core::sh::{brdf, hvl as core_hvl};
 
 use super::image::Image;
-use super::lobes::{self, ShadingPoint};
-use super::{Kind, Ray, Rgb, Scene};
+use super::{Kind, Ray, Rgb, Scene, ShadingPoint, lobes, path, render_centres};
 
 /// Settings of the `hvl` method.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -141,16 +140,31 @@ fn face_frame(f: usize) -> (DVec3, DVec3, DVec3) {
     (axis, t, b)
 }
 
+/// Per-thread buffers of [`indirect`]: the receiver's coefficients and the SH scratch.
+pub struct Scratch {
+    coeffs: Vec<f32>,
+    sh: Vec<f32>,
+}
+
+impl Default for Scratch {
+    fn default() -> Self {
+        let n = brdf::lambert().bands();
+        Scratch {
+            coeffs: vec![0.0; n * n],
+            sh: vec![0.0; n * n],
+        }
+    }
+}
+
 /// The indirect radiance at a shading point from the placed HVLs.
 pub fn indirect(
     scene: &Scene,
     p: &ShadingPoint,
     hvls: &[Placed],
     visibility: bool,
-    scratch: &mut [f32],
+    scratch: &mut Scratch,
 ) -> Rgb {
     let table = brdf::lambert();
-    let bands = table.bands();
     let albedo = scene.materials[p.material].diffuse();
     if albedo.iter().all(|&a| a == 0.0) {
         return [0.0; 3];
@@ -159,9 +173,9 @@ pub fn indirect(
         return [0.0; 3];
     };
     let theta = frame.to_local(p.wo.as_vec3()).z.clamp(-1.0, 1.0).acos();
-    let mut coeffs = vec![0.0f32; bands * bands];
+    let Scratch { coeffs, sh } = scratch;
     if table
-        .lookup_into(brdf::Part::WithCosine, theta, bands, &mut coeffs)
+        .lookup_into(brdf::Part::WithCosine, theta, table.bands(), coeffs)
         .is_err()
     {
         return [0.0; 3];
@@ -169,21 +183,18 @@ pub fn indirect(
     let rx = core_hvl::Receiver {
         point: p.x.as_vec3(),
         frame,
-        coeffs: &coeffs,
+        coeffs,
     };
     let emission = core_hvl::lambert_emission(1.0);
-    let origin = p.x + p.n * (1e-7 * (1.0 + p.x.abs().max_element()));
+    let origin = path::offset(p.x, p.n);
     let mut acc = [0.0f64; 3];
     for h in hvls {
-        let c = core_hvl::contribution(
-            &h.hvl,
-            &emission,
-            &rx,
-            core_hvl::Horizon::Smoothstep,
-            scratch,
-        )
-        .unwrap_or(0.0) as f64;
-        if c > 0.0 && visibility {
+        let c = core_hvl::contribution(&h.hvl, &emission, &rx, core_hvl::Horizon::Smoothstep, sh)
+            .unwrap_or(0.0) as f64;
+        if c <= 0.0 {
+            continue;
+        }
+        if visibility {
             let to = h.hvl.position().as_dvec3() - origin;
             let d = to.length();
             let ray = Ray {
@@ -194,64 +205,22 @@ pub fn indirect(
                 continue;
             }
         }
-        if c > 0.0 {
-            for (a, w) in acc.iter_mut().zip(h.weight) {
-                *a += c * w;
-            }
+        for (a, w) in acc.iter_mut().zip(h.weight) {
+            *a += c * w;
         }
     }
     [acc[0] * albedo[0], acc[1] * albedo[1], acc[2] * albedo[2]]
 }
 
 /// Direct light by the `lobes` method plus one bounce from HVLs, one pixel-centre sample
-/// per pixel; returns the image and the HVL count.
+/// per pixel ([`super::render_centres`]); returns the image and the HVL count.
 pub fn render(scene: &Scene, o: &Options, bar: &ProgressBar) -> (Image, usize) {
     let hvls = place(scene, o.side);
-    let cam = scene.camera;
-    let (w, h) = (cam.width as usize, cam.height as usize);
-    let bands = brdf::lambert().bands();
-    let rows: Vec<Vec<Rgb>> = (0..h)
-        .into_par_iter()
-        .map(|j| {
-            let mut counts = Default::default();
-            let mut scratch = vec![0.0f32; bands * bands];
-            let row = (0..w)
-                .map(|i| {
-                    let ray = cam.centre_ray(i as u32, j as u32);
-                    let Some(hit) = scene.intersect(&ray, 0.0, f64::INFINITY) else {
-                        return scene.environment_radiance(ray.d);
-                    };
-                    let obj = scene.objects[hit.object];
-                    match obj.kind {
-                        Kind::Light(li) => scene.lights[li].radiance,
-                        Kind::Surface(mi) => {
-                            let x = ray.o + hit.t * ray.d;
-                            let wo = -ray.d;
-                            let mut n = obj.shape.normal(x);
-                            if n.dot(wo) < 0.0 {
-                                n = -n;
-                            }
-                            let p = ShadingPoint {
-                                object: hit.object,
-                                material: mi,
-                                x,
-                                n,
-                                wo,
-                            };
-                            let d = lobes::shade(scene, &p, &o.direct, &mut counts);
-                            let ind = indirect(scene, &p, &hvls, o.visibility, &mut scratch);
-                            [d[0] + ind[0], d[1] + ind[1], d[2] + ind[2]]
-                        }
-                    }
-                })
-                .collect();
-            bar.inc(1);
-            row
-        })
-        .collect();
-    let mut img = Image::new(w, h);
-    for (j, row) in rows.into_iter().enumerate() {
-        img.data[j * w..(j + 1) * w].copy_from_slice(&row);
-    }
+    let new_state = || (ProductCounts::default(), Scratch::default());
+    let (img, _) = render_centres(scene, bar, new_state, |(counts, scratch), p| {
+        let d = lobes::shade(scene, p, &o.direct, counts);
+        let ind = indirect(scene, p, &hvls, o.visibility, scratch);
+        [d[0] + ind[0], d[1] + ind[1], d[2] + ind[2]]
+    });
     (img, hvls.len())
 }

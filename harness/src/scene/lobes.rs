@@ -27,7 +27,6 @@
 
 use glam::{DVec3, Vec3};
 use indicatif::ProgressBar;
-use rayon::prelude::*;
 use steradian_core::lobe::CosineLobe;
 use steradian_core::lobe::cap::{CapFit, SphericalCap};
 use steradian_core::lobe::mask::{self, Leaves};
@@ -36,7 +35,7 @@ use steradian_core::lobe::sum::{
 };
 
 use super::image::Image;
-use super::{Kind, Rgb, Scene, Shape};
+use super::{Kind, Rgb, Scene, ShadingPoint, Shape, render_centres};
 
 /// How visibility becomes lobes.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -83,21 +82,6 @@ impl Default for Options {
 
 fn f32v(v: DVec3) -> Vec3 {
     v.as_vec3()
-}
-
-/// A shading point: where, on what, seen from where.
-#[derive(Clone, Copy, Debug)]
-pub struct ShadingPoint {
-    /// Index of the object shaded (it does not occlude itself).
-    pub object: usize,
-    /// Its material.
-    pub material: usize,
-    /// The point.
-    pub x: DVec3,
-    /// Unit normal, on the viewer's side.
-    pub n: DVec3,
-    /// Unit direction toward the viewer.
-    pub wo: DVec3,
 }
 
 /// The reflected radiance at a shading point.
@@ -180,7 +164,7 @@ pub fn shade(scene: &Scene, p: &ShadingPoint, o: &Options, counts: &mut ProductC
         };
         let i_d = chain(&LobeSum::with_constant(1.0 / std::f32::consts::PI));
         let mut acc = diffuse.map(|d| d * i_d);
-        for g in &glossy {
+        for g in glossy.iter() {
             let lobe = CosineLobe::saturating(f32v(g.axis), 1.0, g.exponent as f32);
             let r = LobeSum::<1>::from_lobes(0.0, &[lobe]);
             let i_g = chain(&r);
@@ -195,63 +179,15 @@ pub fn shade(scene: &Scene, p: &ShadingPoint, o: &Options, counts: &mut ProductC
     out
 }
 
-/// One pixel-centre sample per pixel: a light or the environment as seen, a surface shaded
-/// by [`shade`]. Rows in parallel.
+/// One pixel-centre sample per pixel ([`super::render_centres`]), surfaces shaded by
+/// [`shade`]; the product counts of the whole image.
 pub fn render(scene: &Scene, o: &Options, bar: &ProgressBar) -> (Image, ProductCounts) {
-    let cam = scene.camera;
-    let (w, h) = (cam.width as usize, cam.height as usize);
-    let rows: Vec<(Vec<Rgb>, ProductCounts)> = (0..h)
-        .into_par_iter()
-        .map(|j| {
-            let mut counts = ProductCounts::default();
-            let row = (0..w)
-                .map(|i| {
-                    let ray = cam.centre_ray(i as u32, j as u32);
-                    match scene.intersect(&ray, 0.0, f64::INFINITY) {
-                        None => scene.environment_radiance(ray.d),
-                        Some(hit) => {
-                            let obj = scene.objects[hit.object];
-                            match obj.kind {
-                                Kind::Light(li) => scene.lights[li].radiance,
-                                Kind::Surface(mi) => {
-                                    let x = ray.o + hit.t * ray.d;
-                                    let wo = -ray.d;
-                                    let mut n = obj.shape.normal(x);
-                                    if n.dot(wo) < 0.0 {
-                                        n = -n;
-                                    }
-                                    shade(
-                                        scene,
-                                        &ShadingPoint {
-                                            object: hit.object,
-                                            material: mi,
-                                            x,
-                                            n,
-                                            wo,
-                                        },
-                                        o,
-                                        &mut counts,
-                                    )
-                                }
-                            }
-                        }
-                    }
-                })
-                .collect();
-            bar.inc(1);
-            (row, counts)
-        })
-        .collect();
-    let mut img = Image::new(w, h);
+    let (img, rows) = render_centres(scene, bar, ProductCounts::default, |counts, p| {
+        shade(scene, p, o, counts)
+    });
     let mut total = ProductCounts::default();
-    for (j, (row, c)) in rows.into_iter().enumerate() {
-        img.data[j * w..(j + 1) * w].copy_from_slice(&row);
-        total.computed += c.computed;
-        total.scaled += c.scaled;
-        total.pruned += c.pruned;
-        total.skipped_bound += c.skipped_bound;
-        total.skipped_chain += c.skipped_chain;
-        total.overflowed += c.overflowed;
+    for c in rows {
+        total += c;
     }
     (img, total)
 }

@@ -60,7 +60,7 @@ pub enum Material {
 }
 
 /// One lobe of a material at a given view: `scale·max(axis·ωi, 0)^exponent`.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct ViewLobe {
     /// Unit axis.
     pub axis: DVec3,
@@ -171,38 +171,39 @@ impl Material {
         }
     }
 
-    /// The glossy lobes at unit normal `n` and unit view `wo` (toward the viewer).
-    pub fn lobes(&self, n: DVec3, wo: DVec3) -> Vec<ViewLobe> {
+    /// The glossy lobes at unit normal `n` and unit view `wo` (toward the viewer); at most
+    /// [`MAX_LOBES`] (a Lafortune material is validated to 1–4 lobes; more are ignored).
+    pub fn lobes(&self, n: DVec3, wo: DVec3) -> ViewLobes {
+        let mut out = ViewLobes::default();
         match self {
-            Material::Lambert { .. } => Vec::new(),
+            Material::Lambert { .. } => {}
             Material::Phong {
                 specular, exponent, ..
             } => {
                 let k = (exponent + 2.0) / TAU;
-                vec![ViewLobe {
+                out.push(ViewLobe {
                     axis: reflect(wo, n),
                     exponent: *exponent,
                     scale: specular.map(|s| s * k),
-                }]
+                });
             }
-            Material::Lafortune { lobes, .. } => lobes
-                .iter()
-                .filter_map(|l| {
-                    let z = wo.dot(n);
+            Material::Lafortune { lobes, .. } => {
+                let z = wo.dot(n);
+                for l in lobes {
                     let m = l.c * (wo - z * n) + l.cz * z * n;
                     let len = m.length();
-                    if len == 0.0 {
-                        return None;
+                    if len > 0.0 {
+                        let k = len.powf(l.exponent);
+                        out.push(ViewLobe {
+                            axis: m / len,
+                            exponent: l.exponent,
+                            scale: l.rho.map(|r| r * k),
+                        });
                     }
-                    let k = len.powf(l.exponent);
-                    Some(ViewLobe {
-                        axis: m / len,
-                        exponent: l.exponent,
-                        scale: l.rho.map(|r| r * k),
-                    })
-                })
-                .collect(),
+                }
+            }
         }
+        out
     }
 
     /// `f_r(ωi, ωo)` (no cosine), 0 unless both are above the surface.
@@ -211,7 +212,7 @@ impl Material {
             return [0.0; 3];
         }
         let mut f = self.diffuse().map(|d| d / PI);
-        for l in self.lobes(n, wo) {
+        for l in self.lobes(n, wo).iter() {
             let c = l.axis.dot(wi);
             if c > 0.0 {
                 let v = c.powf(l.exponent);
@@ -223,79 +224,96 @@ impl Material {
         f
     }
 
-    /// Selection weights: diffuse first, then one per lobe (not normalised).
-    fn weights(&self, lobes: &[ViewLobe]) -> (f64, Vec<f64>) {
+    /// The sampling mixture at this view: `None` when the material reflects nothing.
+    fn mixture(&self, n: DVec3, wo: DVec3) -> Option<Mixture> {
+        if n.dot(wo) <= 0.0 {
+            return None;
+        }
+        let lobes = self.lobes(n, wo);
+        let mut w = [0.0; MAX_LOBES];
+        for (wk, l) in w.iter_mut().zip(lobes.iter()) {
+            *wk = lum(l.scale) * TAU / (l.exponent + 1.0);
+        }
         let d = lum(self.diffuse());
-        let w = lobes
-            .iter()
-            .map(|l| lum(l.scale) * TAU / (l.exponent + 1.0))
-            .collect();
-        (d, w)
+        let total = d + w.iter().sum::<f64>();
+        (total > 0.0 && total.is_finite()).then_some(Mixture {
+            n,
+            lobes,
+            d,
+            w,
+            total,
+        })
     }
 
     /// Samples `ωi`; returns it with the mixture density, or `None` when the material
     /// reflects nothing from this view.
     pub fn sample(&self, n: DVec3, wo: DVec3, u: [f64; 3]) -> Option<(DVec3, f64)> {
-        if n.dot(wo) <= 0.0 {
-            return None;
-        }
-        let lobes = self.lobes(n, wo);
-        let (d, w) = self.weights(&lobes);
-        let total = d + w.iter().sum::<f64>();
-        if total <= 0.0 || !total.is_finite() {
-            return None;
-        }
-        let mut pick = u[0] * total;
-        let wi = if pick < d || lobes.is_empty() {
+        let m = self.mixture(n, wo)?;
+        let mut pick = u[0] * m.total;
+        let wi = if pick < m.d || m.lobes.is_empty() {
             sample_power_cosine(n, 1.0, u[1], u[2])
         } else {
-            pick -= d;
-            let mut k = lobes.len() - 1;
-            for (i, wk) in w.iter().enumerate() {
+            pick -= m.d;
+            let mut k = m.lobes.len() - 1;
+            for (i, wk) in m.w.iter().enumerate().take(m.lobes.len()) {
                 if pick < *wk {
                     k = i;
                     break;
                 }
                 pick -= wk;
             }
-            sample_power_cosine(lobes[k].axis, lobes[k].exponent, u[1], u[2])
+            sample_power_cosine(m.lobes[k].axis, m.lobes[k].exponent, u[1], u[2])
         };
-        let pdf = self.pdf_with(n, &lobes, d, &w, total, wi);
+        let pdf = m.pdf(wi);
         (pdf > 0.0).then_some((wi, pdf))
     }
 
     /// The density [`Material::sample`] draws `ωi` with.
     pub fn pdf(&self, n: DVec3, wo: DVec3, wi: DVec3) -> f64 {
-        if n.dot(wo) <= 0.0 {
-            return 0.0;
-        }
-        let lobes = self.lobes(n, wo);
-        let (d, w) = self.weights(&lobes);
-        let total = d + w.iter().sum::<f64>();
-        if total <= 0.0 || !total.is_finite() {
-            return 0.0;
-        }
-        self.pdf_with(n, &lobes, d, &w, total, wi)
+        self.mixture(n, wo).map_or(0.0, |m| m.pdf(wi))
     }
+}
 
-    fn pdf_with(
-        &self,
-        n: DVec3,
-        lobes: &[ViewLobe],
-        d: f64,
-        w: &[f64],
-        total: f64,
-        wi: DVec3,
-    ) -> f64 {
-        // With no lobes the diffuse part is drawn whatever its weight.
-        let (d, total) = if lobes.is_empty() {
-            (1.0, 1.0)
-        } else {
-            (d, total)
-        };
-        let mut p = d / total * power_cosine_pdf(n, 1.0, wi);
-        for (l, wk) in lobes.iter().zip(w) {
-            p += wk / total * power_cosine_pdf(l.axis, l.exponent, wi);
+/// Most glossy lobes a material has.
+pub const MAX_LOBES: usize = 4;
+
+/// The glossy lobes of a material at one view, without allocating.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct ViewLobes {
+    lobes: [ViewLobe; MAX_LOBES],
+    len: usize,
+}
+
+impl ViewLobes {
+    fn push(&mut self, l: ViewLobe) {
+        if self.len < MAX_LOBES {
+            self.lobes[self.len] = l;
+            self.len += 1;
+        }
+    }
+}
+
+impl std::ops::Deref for ViewLobes {
+    type Target = [ViewLobe];
+    fn deref(&self) -> &[ViewLobe] {
+        &self.lobes[..self.len]
+    }
+}
+
+/// The sampling mixture of one view: diffuse weight `d`, lobe weights `w`.
+struct Mixture {
+    n: DVec3,
+    lobes: ViewLobes,
+    d: f64,
+    w: [f64; MAX_LOBES],
+    total: f64,
+}
+
+impl Mixture {
+    fn pdf(&self, wi: DVec3) -> f64 {
+        let mut p = self.d / self.total * power_cosine_pdf(self.n, 1.0, wi);
+        for (l, wk) in self.lobes.iter().zip(&self.w) {
+            p += wk / self.total * power_cosine_pdf(l.axis, l.exponent, wi);
         }
         p
     }

@@ -79,28 +79,27 @@ pub struct Metrics {
     pub exposure: f64,
 }
 
-/// Compares `img` with `reference` (and its standard error, when known).
+/// Compares `img` with `reference` (and its standard error, when known), pixels classified
+/// by [`classify`].
 pub fn compare(
-    scene: &Scene,
+    class: &[Option<bool>],
     img: &Image,
     reference: &Image,
     stderr: Option<&Image>,
     exposure: f64,
 ) -> Result<Metrics, String> {
     if (img.width, img.height) != (reference.width, reference.height)
-        || img.width * img.height != scene.camera.pixels()
+        || img.width * img.height != class.len()
     {
         return Err(format!(
-            "image sizes differ: {}×{} vs reference {}×{} (scene {}×{})",
+            "image sizes differ: {}×{} vs reference {}×{} ({} classified pixels)",
             img.width,
             img.height,
             reference.width,
             reference.height,
-            scene.camera.width,
-            scene.camera.height
+            class.len()
         ));
     }
-    let class = classify(scene);
     let mut max_radiance: f64 = 0.0;
     for (k, c) in class.iter().enumerate() {
         if *c == Some(true) {
@@ -183,13 +182,12 @@ pub fn compare(
 /// where the method is brighter, blue where darker, full at `±range` (relative to the
 /// reference's `max_radiance`), grey elsewhere.
 pub fn difference_image(
-    scene: &Scene,
+    class: &[Option<bool>],
     img: &Image,
     reference: &Image,
     max_radiance: f64,
     range: f64,
 ) -> Image {
-    let class = classify(scene);
     let mut out = Image::new(img.width, img.height);
     let s = if max_radiance > 0.0 {
         max_radiance

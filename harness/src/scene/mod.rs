@@ -32,8 +32,11 @@ pub mod rsl;
 use std::path::Path;
 
 use glam::DVec3;
+use indicatif::ProgressBar;
+use rayon::prelude::*;
 
 pub use geom::{Camera, Hit, Ray, Shape};
+pub use image::Image;
 pub use light::{Environment, SphereLight};
 pub use material::Material;
 
@@ -252,15 +255,89 @@ impl Scene {
             .map_or([0.0; 3], |e| e.radiance(d))
     }
 
-    /// A scale for intersection offsets: the size of the scene around the camera.
-    pub fn epsilon(&self) -> f64 {
-        let mut s = self.camera.eye.abs().max_element();
-        for o in &self.objects {
-            s = s.max(match o.shape {
-                Shape::Sphere { center, radius } => center.abs().max_element() + radius,
-                Shape::Plane { point, .. } => point.abs().max_element(),
-            });
+    /// What `ray` meets first: the environment (black without one) when it escapes, a
+    /// light's radiance, or a surface point with its normal turned toward the viewer
+    /// (planes are two-sided).
+    pub fn see(&self, ray: &Ray) -> Seen {
+        let Some(hit) = self.intersect(ray, 0.0, f64::INFINITY) else {
+            return Seen::Radiance(self.environment_radiance(ray.d));
+        };
+        let obj = self.objects[hit.object];
+        match obj.kind {
+            Kind::Light(li) => Seen::Radiance(self.lights[li].radiance),
+            Kind::Surface(material) => {
+                let x = ray.o + hit.t * ray.d;
+                let wo = -ray.d;
+                let mut n = obj.shape.normal(x);
+                if n.dot(wo) < 0.0 {
+                    n = -n;
+                }
+                Seen::Surface(ShadingPoint {
+                    object: hit.object,
+                    material,
+                    x,
+                    n,
+                    wo,
+                })
+            }
         }
-        1e-9 * s.max(1.0)
     }
+}
+
+/// A shading point: where, on what, seen from where.
+#[derive(Clone, Copy, Debug)]
+pub struct ShadingPoint {
+    /// Index of the object shaded (it does not occlude itself).
+    pub object: usize,
+    /// Its material.
+    pub material: usize,
+    /// The point.
+    pub x: DVec3,
+    /// Unit normal, on the viewer's side.
+    pub n: DVec3,
+    /// Unit direction toward the viewer.
+    pub wo: DVec3,
+}
+
+/// What a ray sees first ([`Scene::see`]).
+#[derive(Clone, Copy, Debug)]
+pub enum Seen {
+    /// A light or the environment, at this radiance.
+    Radiance(Rgb),
+    /// A surface point to shade.
+    Surface(ShadingPoint),
+}
+
+/// The image of the pixel-centre rays, rows in parallel: a light or the environment as
+/// seen, a surface by `shade(state, point)`. Each row gets a fresh `new_state()` (scratch
+/// buffers, counters), returned row by row with the image.
+pub fn render_centres<S: Send>(
+    scene: &Scene,
+    bar: &ProgressBar,
+    new_state: impl Fn() -> S + Sync,
+    shade: impl Fn(&mut S, &ShadingPoint) -> Rgb + Sync,
+) -> (Image, Vec<S>) {
+    let cam = scene.camera;
+    let (w, h) = (cam.width as usize, cam.height as usize);
+    let rows: Vec<(Vec<Rgb>, S)> = (0..h)
+        .into_par_iter()
+        .map(|j| {
+            let mut state = new_state();
+            let row = (0..w)
+                .map(|i| match scene.see(&cam.centre_ray(i as u32, j as u32)) {
+                    Seen::Radiance(l) => l,
+                    Seen::Surface(p) => shade(&mut state, &p),
+                })
+                .collect();
+            bar.inc(1);
+            (row, state)
+        })
+        .collect();
+    let mut img = Image::new(w, h);
+    let mut states = Vec::with_capacity(h);
+    for (j, (row, state)) in rows.into_iter().enumerate() {
+        img.data[j * w..(j + 1) * w].copy_from_slice(&row);
+        states.push(state);
+    }
+    (img, states)
 }

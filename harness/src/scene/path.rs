@@ -53,9 +53,10 @@ fn add(l: &mut Rgb, beta: Rgb, v: Rgb, k: f64) {
     }
 }
 
-/// The offset origin for rays leaving `x` on the side of `n`.
-fn offset(scene: &Scene, x: DVec3, n: DVec3) -> DVec3 {
-    x + n * (1e-7 * (1.0 + x.abs().max_element()) + scene.epsilon())
+/// The origin of rays leaving the surface point `x` on the side of `n`: offset by
+/// `1e-7·(1 + |x|∞)`, far above the rounding of the hit point, far below any feature size.
+pub fn offset(x: DVec3, n: DVec3) -> DVec3 {
+    x + n * (1e-7 * (1.0 + x.abs().max_element()))
 }
 
 /// One radiance sample along a camera ray.
@@ -99,7 +100,7 @@ pub fn radiance(scene: &Scene, ray: Ray, bounces: u32, rng: &mut Rng) -> Rgb {
         if n.dot(wo) < 0.0 {
             n = -n;
         }
-        let origin = offset(scene, x, n);
+        let origin = offset(x, n);
         for light in &scene.lights {
             let (u1, u2) = (rng.unit(), rng.unit());
             let Some(cone) = Cone::of_sphere(origin, light.center, light.radius) else {

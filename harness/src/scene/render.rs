@@ -2,7 +2,7 @@
 //! `M.json` (plus `path_stderr.exr` for the reference), and compares with `path.exr`
 //! when the output folder holds one.
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::time::Instant;
 
 use indicatif::{ProgressBar, ProgressStyle};
@@ -115,10 +115,25 @@ pub struct Outcome {
     pub json: serde_json::Value,
 }
 
+/// What a method will build for a scene, and why ([`plan`]).
+#[derive(Clone, Debug)]
+pub struct Plan {
+    /// The choices with their reasons, as printed and kept in `M.json`.
+    pub items: Vec<PlanItem>,
+    /// Settings of the `lobes` method (also the direct light of `hvl`).
+    pub lobes: lobes::Options,
+    /// Settings of the `hvl` method.
+    pub hvl: super::hvl::Options,
+    /// Settings of the `rsl` method.
+    pub rsl: super::rsl::Options,
+}
+
 /// The plan of a method for a scene: what it builds and why.
-pub fn plan(scene: &Scene, o: &Options) -> Result<(Vec<PlanItem>, lobes::Options), String> {
+pub fn plan(scene: &Scene, o: &Options) -> Result<Plan, String> {
     let mut p = Vec::new();
     let mut lo = lobes::Options::default();
+    let r = super::rsl::Options::default();
+    let mut hv = super::hvl::Options::default();
     match o.method {
         Method::Path => {
             p.push(PlanItem {
@@ -136,7 +151,6 @@ pub fn plan(scene: &Scene, o: &Options) -> Result<(Vec<PlanItem>, lobes::Options
             if scene.environment.is_none() {
                 return Err("method rsl lights with an environment; this scene has none".into());
             }
-            let r = super::rsl::Options::default();
             p.push(PlanItem {
                 item: "rsls".into(),
                 value: json!(r.k),
@@ -214,7 +228,13 @@ pub fn plan(scene: &Scene, o: &Options) -> Result<(Vec<PlanItem>, lobes::Options
             });
         }
     }
-    Ok((p, lo))
+    hv.direct = lo;
+    Ok(Plan {
+        items: p,
+        lobes: lo,
+        hvl: hv,
+        rsl: r,
+    })
 }
 
 fn bar(rows: u64, quiet: bool, label: &str) -> ProgressBar {
@@ -231,9 +251,8 @@ fn bar(rows: u64, quiet: bool, label: &str) -> ProgressBar {
     b
 }
 
-/// Renders `scene` as `o` says and writes the outputs.
-pub fn run(scene: &Scene, scene_name: &str, o: &Options) -> Result<Outcome, String> {
-    let (plan, lobe_opts) = plan(scene, o)?;
+/// Renders `scene` by `plan` (from [`plan`] with the same options) and writes the outputs.
+pub fn run(scene: &Scene, scene_name: &str, o: &Options, plan: &Plan) -> Result<Outcome, String> {
     std::fs::create_dir_all(&o.out).map_err(|e| format!("{}: {e}", o.out.display()))?;
     let rows = scene.camera.height as u64;
     let b = bar(rows, o.quiet, o.method.name());
@@ -252,7 +271,7 @@ pub fn run(scene: &Scene, scene_name: &str, o: &Options) -> Result<Outcome, Stri
             (out.image, Some(out.stderr), json!({}))
         }
         Method::Lobes => {
-            let (img, counts) = lobes::render(scene, &lobe_opts, &b);
+            let (img, counts) = lobes::render(scene, &plan.lobes, &b);
             let px = scene.camera.pixels().max(1) as f64;
             (
                 img,
@@ -265,19 +284,11 @@ pub fn run(scene: &Scene, scene_name: &str, o: &Options) -> Result<Outcome, Stri
             )
         }
         Method::Rsl => {
-            let img = super::rsl::render(scene, &super::rsl::Options::default(), &b)?;
-            (
-                img,
-                None,
-                json!({ "rsls": super::rsl::Options::default().k }),
-            )
+            let img = super::rsl::render(scene, &plan.rsl, &b)?;
+            (img, None, json!({ "rsls": plan.rsl.k }))
         }
         Method::Hvl => {
-            let ho = super::hvl::Options {
-                direct: lobe_opts,
-                ..Default::default()
-            };
-            let (img, count) = super::hvl::render(scene, &ho, &b);
+            let (img, count) = super::hvl::render(scene, &plan.hvl, &b);
             (img, None, json!({ "hvls": count }))
         }
     };
@@ -289,12 +300,20 @@ pub fn run(scene: &Scene, scene_name: &str, o: &Options) -> Result<Outcome, Stri
     if let Some(se) = &stderr {
         se.write_exr(&o.out.join("path_stderr.exr"))?;
     }
-    let metrics = compare_with_reference(scene, &image, &o.out, o)?;
-    if let Some(m) = &metrics {
-        let diff =
-            metrics::difference_image(scene, &image, &reference(&o.out)?, m.max_radiance, 0.05);
+    // Errors against `DIR/path.exr` (and its standard error), when it exists and this
+    // render is not the reference itself.
+    let reference_path = o.out.join("path.exr");
+    let metrics = if o.method != Method::Path && reference_path.exists() {
+        let r = Image::read(&reference_path)?;
+        let se = Image::read(&o.out.join("path_stderr.exr")).ok();
+        let class = metrics::classify(scene);
+        let m = metrics::compare(&class, &image, &r, se.as_ref(), o.exposure)?;
+        let diff = metrics::difference_image(&class, &image, &r, m.max_radiance, 0.05);
         diff.write_png(&o.out.join(format!("{name}_diff.png")), 0.0)?;
-    }
+        Some(m)
+    } else {
+        None
+    };
     let px = scene.camera.pixels() as f64;
     let samples = match o.method {
         Method::Path => px * o.spp.max(1) as f64,
@@ -309,7 +328,7 @@ pub fn run(scene: &Scene, scene_name: &str, o: &Options) -> Result<Outcome, Stri
             "spp": o.spp, "bounces": o.bounces, "target_error": o.target_error,
             "exposure": o.exposure, "seed": o.seed,
         },
-        "plan": plan,
+        "plan": plan.items,
         "seconds": seconds,
         "threads": rayon::current_num_threads(),
         "shading_points_per_second": samples / seconds.max(1e-9),
@@ -322,29 +341,9 @@ pub fn run(scene: &Scene, scene_name: &str, o: &Options) -> Result<Outcome, Stri
     Ok(Outcome {
         image,
         stderr,
-        plan,
+        plan: plan.items.clone(),
         seconds,
         metrics,
         json,
     })
-}
-
-fn reference(dir: &Path) -> Result<Image, String> {
-    Image::read(&dir.join("path.exr"))
-}
-
-/// Errors against `DIR/path.exr` (and `DIR/path_stderr.exr`), when `DIR/path.exr` exists
-/// and this render is not the reference itself.
-fn compare_with_reference(
-    scene: &Scene,
-    image: &Image,
-    dir: &Path,
-    o: &Options,
-) -> Result<Option<Metrics>, String> {
-    if o.method == Method::Path || !dir.join("path.exr").exists() {
-        return Ok(None);
-    }
-    let r = reference(dir)?;
-    let se = Image::read(&dir.join("path_stderr.exr")).ok();
-    metrics::compare(scene, image, &r, se.as_ref(), o.exposure).map(Some)
 }

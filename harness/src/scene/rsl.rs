@@ -20,7 +20,6 @@ use std::collections::BTreeMap;
 use std::f32::consts::FRAC_PI_2;
 
 use indicatif::ProgressBar;
-use rayon::prelude::*;
 use steradian_core::frame::Frame;
 use steradian_core::lobe::brdf::{Lambert, Phong};
 use steradian_core::lobe::cap::SphericalCap;
@@ -30,9 +29,8 @@ use steradian_core::rsl::vis_moments::VisMoments;
 use steradian_core::rsl::visibility::{Outside, coverage_into, local_cap};
 
 use super::image::Image;
-use super::lobes::ShadingPoint;
 use super::material::Material;
-use super::{Kind, Rgb, Scene, Shape};
+use super::{Rgb, Scene, ShadingPoint, Shape, render_centres};
 use crate::env::Equirect;
 use crate::env::decompose::decompose;
 
@@ -184,50 +182,12 @@ pub fn shade_point(
     out
 }
 
-/// One pixel-centre sample per pixel, rows in parallel.
+/// One pixel-centre sample per pixel ([`super::render_centres`]).
 pub fn render(scene: &Scene, o: &Options, bar: &ProgressBar) -> Result<Image, String> {
     let built = build(scene, o)?;
-    let cam = scene.camera;
-    let (w, h) = (cam.width as usize, cam.height as usize);
-    let rows: Vec<Vec<Rgb>> = (0..h)
-        .into_par_iter()
-        .map(|j| {
-            let mut cov = vec![0.0f32; o.vis_side * o.vis_side];
-            let row = (0..w)
-                .map(|i| {
-                    let ray = cam.centre_ray(i as u32, j as u32);
-                    let Some(hit) = scene.intersect(&ray, 0.0, f64::INFINITY) else {
-                        return scene.environment_radiance(ray.d);
-                    };
-                    let obj = scene.objects[hit.object];
-                    match obj.kind {
-                        Kind::Light(li) => scene.lights[li].radiance,
-                        Kind::Surface(mi) => {
-                            let x = ray.o + hit.t * ray.d;
-                            let wo = -ray.d;
-                            let mut n = obj.shape.normal(x);
-                            if n.dot(wo) < 0.0 {
-                                n = -n;
-                            }
-                            let p = ShadingPoint {
-                                object: hit.object,
-                                material: mi,
-                                x,
-                                n,
-                                wo,
-                            };
-                            shade_point(scene, &built, o, &p, &mut cov)
-                        }
-                    }
-                })
-                .collect();
-            bar.inc(1);
-            row
-        })
-        .collect();
-    let mut img = Image::new(w, h);
-    for (j, row) in rows.into_iter().enumerate() {
-        img.data[j * w..(j + 1) * w].copy_from_slice(&row);
-    }
+    let new_cov = || vec![0.0f32; o.vis_side * o.vis_side];
+    let (img, _) = render_centres(scene, bar, new_cov, |cov, p| {
+        shade_point(scene, &built, o, p, cov)
+    });
     Ok(img)
 }
