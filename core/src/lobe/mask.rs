@@ -264,6 +264,37 @@ mod tests {
         }
     }
 
+    /// Linear interpolation in `ln dist` is exact at the table's nodes, and clamps beyond
+    /// its range.
+    #[test]
+    fn weight_reproduces_the_nodes_and_clamps() {
+        let (lo, hi) = WEIGHT_DIST_RANGE;
+        let table: [f32; WEIGHT_LEN] = core::array::from_fn(|k| k as f32);
+        for d in 0..WEIGHT_DEPTHS {
+            for i in 0..WEIGHT_DISTS {
+                let u = i as f32 / (WEIGHT_DISTS - 1) as f32;
+                let dist = math::expf(math::logf(lo) + u * (math::logf(hi) - math::logf(lo)));
+                let want = (i + WEIGHT_DISTS * d) as f32;
+                let got = weight(&table, dist, d as u32);
+                assert!(
+                    (got - want).abs() < 1e-3,
+                    "node {i}, depth {d}: {got} vs {want}"
+                );
+            }
+            let row = (WEIGHT_DISTS * d) as f32;
+            assert_eq!(weight(&table, lo / 10.0, d as u32), row);
+            assert_eq!(
+                weight(&table, hi * 10.0, d as u32),
+                row + (WEIGHT_DISTS - 1) as f32
+            );
+        }
+        // A depth beyond the table reads the deepest level.
+        assert_eq!(
+            weight(&table, lo, MAX_DEPTH + 3),
+            weight(&table, lo, MAX_DEPTH)
+        );
+    }
+
     #[test]
     fn no_occluder_no_leaf_and_a_covering_occluder_one_leaf() {
         let light = SphericalCap::new(Vec3::Z, 0.1).unwrap();

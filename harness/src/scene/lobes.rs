@@ -57,9 +57,9 @@ pub enum Visibility {
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Options {
     /// How caps become lobes: energy-preserving by default, which the harness test
-    /// `lobes_method_against_the_path_tracer_on_small_builtin_scenes` measures 2–3× more
-    /// accurate than the L2 fit of eq. 32 against the path tracer (the L2 lobe is wider
-    /// than the cap and integrates to more than its solid angle).
+    /// `lobes_method_against_the_path_tracer_on_small_builtin_scenes` asserts more accurate
+    /// than the L2 fit of eq. 32 against the path tracer on both `lobes` and `cluster` (the
+    /// L2 lobe is wider than the cap and integrates to more than its solid angle).
     pub fit: CapFit,
     /// Pruning threshold relative to each chain's unshadowed value.
     pub threshold: f32,

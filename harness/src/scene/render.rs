@@ -207,7 +207,8 @@ pub fn plan(scene: &Scene, o: &Options) -> Result<Plan, String> {
                 item: "cap_fit".into(),
                 value: json!("energy-preserving"),
                 reason: "cap → lobe with the L2 exponent (eq. 32) scaled to the cap's solid \
-                         angle: 2–3× closer to the path tracer than the plain L2 lobe"
+                         angle: closer to the path tracer than the plain L2 lobe (the scene \
+                         tests assert it)"
                     .into(),
             });
             p.push(PlanItem {
