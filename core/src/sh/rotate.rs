@@ -289,6 +289,12 @@ pub fn operator_into(
     Ok(())
 }
 
+/// `Err` unless `op` holds the blocks of [`operator_into`] for `bands` bands (at least
+/// [`operator_len`]`(bands)` values): the check every application of an operator makes.
+pub fn check_operator(op: &[f32], bands: usize) -> Result<(), Error> {
+    check_len("rotation operator", op.len(), operator_len(bands))
+}
+
 fn check_len(what: &'static str, len: usize, need: usize) -> Result<(), Error> {
     if len < need {
         return Err(Error::OutOfRange {
@@ -388,7 +394,7 @@ pub fn apply_operator(
 ) -> Result<(), Error> {
     check_shape(bands, input.len())?;
     check_shape(bands, out.len())?;
-    check_len("rotation operator", op.len(), operator_len(bands))?;
+    check_operator(op, bands)?;
     for l in 0..bands {
         let w = 2 * l + 1;
         let block = &op[operator_len(l)..operator_len(l + 1)];

@@ -40,6 +40,21 @@ pub fn try_gpu() -> Result<Gpu, String> {
     Gpu::new()
 }
 
+/// The adapter when `wanted`, with the note a report prints: the adapter's description,
+/// `not requested`, or `no adapter: why`.
+pub fn if_requested(wanted: bool) -> (Option<Gpu>, String) {
+    if !wanted {
+        return (None, "not requested".to_string());
+    }
+    match try_gpu() {
+        Ok(g) => {
+            let note = g.adapter_info();
+            (Some(g), note)
+        }
+        Err(e) => (None, format!("no adapter: {e}")),
+    }
+}
+
 /// The uniform block of every kernel (`struct Params` in the WGSL sources).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]

@@ -17,7 +17,7 @@ use steradian_core::sh::{self, rotate, window::Window};
 use super::Options;
 use super::section::Section;
 use super::timing::{median_time, median_times_in_turns, ns_per};
-use crate::backend::gpu::{Custom, Gpu, try_gpu};
+use crate::backend::gpu::{self, Custom, Gpu};
 use crate::generate::brdf_sh;
 use crate::kernels::Columns;
 use crate::sh as study;
@@ -372,17 +372,7 @@ fn env_rows(
 /// The section.
 pub fn section(opts: &Options) -> Result<Section, Box<dyn Error>> {
     let rate = study::mul_add_rate();
-    let mut gpu_note = "not requested".to_string();
-    let mut gpu = None;
-    if opts.gpu {
-        match try_gpu() {
-            Ok(g) => {
-                gpu_note = g.adapter_info();
-                gpu = Some(g);
-            }
-            Err(e) => gpu_note = format!("no adapter: {e}"),
-        }
-    }
+    let (mut gpu, gpu_note) = gpu::if_requested(opts.gpu);
     let eval = eval_rows(opts, &mut gpu);
     drop(gpu);
     let rot = rotate_rows(opts);

@@ -20,7 +20,7 @@ use super::Options;
 use super::plot::{Axis, Chart, Pt, Scale, Series};
 use super::section::Section;
 use super::timing::{median_time, ns_per};
-use crate::backend::gpu::{Custom, Gpu, try_gpu};
+use crate::backend::gpu::{self, Custom, Gpu};
 use crate::kernels::Columns;
 use crate::rng::Rng;
 use crate::vdt::{Dist, Family, FamilyErrors, edge_error_by_angle, errors, spheres_mask, study};
@@ -159,17 +159,7 @@ pub fn measure(opts: &Options) -> Result<VdtResults, Box<dyn Error>> {
     bar.inc(1);
 
     bar.set_message("query speed");
-    let mut gpu = None;
-    let mut gpu_note = "not requested".to_string();
-    if opts.gpu {
-        match try_gpu() {
-            Ok(g) => {
-                gpu_note = g.adapter_info();
-                gpu = Some(g);
-            }
-            Err(e) => gpu_note = format!("no adapter: {e}"),
-        }
-    }
+    let (mut gpu, gpu_note) = gpu::if_requested(opts.gpu);
     let queries = opts.scaled(QUERIES);
     let speeds = QUERY_SIDES
         .iter()

@@ -6,7 +6,7 @@
 
 use steradian_core::Error;
 use steradian_core::sh::check_shape;
-use steradian_core::sh::rotate::operator_len;
+use steradian_core::sh::rotate::{check_operator, operator_len};
 use wide::f32x8;
 
 /// `out[k][lane] = (M·input_lane)_k` over `bands` bands for the blocks `op` of
@@ -22,14 +22,7 @@ pub fn apply_operator_x8(
 ) -> Result<(), Error> {
     check_shape(bands, input.len())?;
     check_shape(bands, out.len())?;
-    if op.len() < operator_len(bands) {
-        return Err(Error::OutOfRange {
-            what: "rotation operator",
-            value: op.len() as f32,
-            min: operator_len(bands) as f32,
-            max: f32::INFINITY,
-        });
-    }
+    check_operator(op, bands)?;
     for l in 0..bands {
         let w = 2 * l + 1;
         let block = &op[operator_len(l)..operator_len(l + 1)];
@@ -81,14 +74,7 @@ pub fn apply_operator_slices(
             max: f32::INFINITY,
         });
     }
-    if op.len() < operator_len(bands) {
-        return Err(Error::OutOfRange {
-            what: "rotation operator",
-            value: op.len() as f32,
-            min: operator_len(bands) as f32,
-            max: f32::INFINITY,
-        });
-    }
+    check_operator(op, bands)?;
     let vectors = input.len() / nn;
     // One band of eight vectors at a time, on the stack (at most 2·MAX_BANDS − 1 lanes).
     let mut lanes = [[0.0f32; 8]; 2 * steradian_core::sh::MAX_BANDS - 1];
