@@ -97,6 +97,8 @@ extern crate alloc;
 mod error;
 pub mod math;
 
+#[cfg(feature = "alloc")]
+pub mod cp;
 pub mod frame;
 pub mod grid;
 pub mod lobe;

@@ -12,6 +12,7 @@
 //! crate where a result feeds a committed table, so those bytes are the same on every
 //! machine.
 
+pub mod cp;
 pub mod lobe;
 pub mod quad;
 pub mod rsl;
