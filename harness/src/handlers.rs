@@ -4,7 +4,7 @@
 //! (`crate::registry`) names each kernel's handler.
 
 use serde_json::{Map, Value, json};
-use steradian_core::{Vec2, lobe, lobe::cap, rsl::hemisphere, sh};
+use steradian_core::{Vec2, Vec3, cp, lobe, lobe::cap, rsl::hemisphere, sh};
 
 use crate::json::{bands, exponent, matrix3, nonzero, num, number, scale, sh_coeffs, vector};
 
@@ -103,4 +103,61 @@ pub fn sh_rotate(obj: &Map<String, Value>) -> Result<Value, String> {
         .rotate(&rot, &c, &mut out)
         .map_err(|e| e.to_string())?;
     Ok(json!({ "coeffs": out.into_iter().map(num).collect::<Vec<_>>() }))
+}
+
+/// The level field of the control-point kernels: an integer in `0..=4`.
+fn cp_level(obj: &Map<String, Value>) -> Result<cp::Icosphere, String> {
+    let v = crate::json::field(obj, "level")?;
+    let level = v
+        .as_u64()
+        .filter(|l| *l <= cp::MAX_LEVEL as u64)
+        .ok_or_else(|| format!("level must be an integer in 0..={}, got {v}", cp::MAX_LEVEL))?;
+    cp::Icosphere::new(level as u32).map_err(|e| e.to_string())
+}
+
+/// `cp-vertices`: `{"level": L}` → `{"vertices": [[x, y, z], …]}` in the order of the values
+/// of `cp-query` (printed at round-trip precision).
+pub fn cp_vertices(obj: &Map<String, Value>) -> Result<Value, String> {
+    let mesh = cp_level(obj)?;
+    let v: Vec<Value> = mesh
+        .vertices()
+        .iter()
+        .map(|p| json!([num(p.x), num(p.y), num(p.z)]))
+        .collect();
+    Ok(json!({ "vertices": v }))
+}
+
+/// `cp-query`: `{"level": L, "values": [one per vertex], "dirs": [[x, y, z], …]}` →
+/// `{"values": [one per direction]}`, with the paper's area weights.
+pub fn cp_query(obj: &Map<String, Value>) -> Result<Value, String> {
+    let mesh = cp_level(obj)?;
+    let values: Vec<f32> = crate::json::field(obj, "values")?
+        .as_array()
+        .ok_or_else(|| "values must be an array of numbers".to_string())?
+        .iter()
+        .enumerate()
+        .map(|(i, v)| crate::json::element_f32(v, &format!("values[{i}]")))
+        .collect::<Result<_, _>>()?;
+    mesh.check(&values).map_err(|e| e.to_string())?;
+    let dirs = crate::json::field(obj, "dirs")?
+        .as_array()
+        .ok_or_else(|| "dirs must be an array of [x, y, z]".to_string())?;
+    let mut out = Vec::with_capacity(dirs.len());
+    for (i, d) in dirs.iter().enumerate() {
+        let xyz = d
+            .as_array()
+            .filter(|a| a.len() == 3)
+            .ok_or_else(|| format!("dirs[{i}] must be [x, y, z]"))?;
+        let p: Vec<f32> = xyz
+            .iter()
+            .enumerate()
+            .map(|(k, v)| crate::json::element_f32(v, &format!("dirs[{i}][{k}]")))
+            .collect::<Result<_, _>>()?;
+        let d = Vec3::new(p[0], p[1], p[2]);
+        let v = mesh
+            .query(&values, d, cp::Weights::Area)
+            .map_err(|e| format!("dirs[{i}]: {e}"))?;
+        out.push(num(v));
+    }
+    Ok(json!({ "values": out }))
 }

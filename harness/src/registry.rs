@@ -48,6 +48,9 @@ pub enum Paper {
     Rsl,
     /// `sh/`: real spherical harmonics and the projections of the HVL paper (Mézières et al.).
     Sh,
+    /// `cp/`: control-point spherical functions on a subdivided icosahedron (Chatelier and
+    /// Malgouyres).
+    Cp,
 }
 
 impl Paper {
@@ -57,6 +60,7 @@ impl Paper {
             Paper::Lobe => "lobe",
             Paper::Rsl => "rsl",
             Paper::Sh => "sh",
+            Paper::Cp => "cp",
         }
     }
 }
@@ -411,6 +415,39 @@ pub const KERNELS: &[KernelSpec] = &[
             metric: "‖error‖/‖c‖",
             item: "steradian_core::sh::rotate::rotate_rel_error",
             value: Some(4e-7),
+        }),
+        batch: None,
+        tables: &[],
+    },
+    KernelSpec {
+        name: "cp-vertices",
+        paper: Paper::Cp,
+        contract: r#"{"level": L in 0..=4} -> {"vertices": [[x,y,z], …]} (10·4^L + 2 unit vectors, the order values are indexed in)"#,
+        eval: Piece::At(handlers::cp_vertices),
+        scalar: "steradian_core::cp::mesh::Icosphere::new",
+        simd: Piece::Without("a table built once, not a batch kernel"),
+        wgsl: Piece::Without("a table built once on the CPU, not a GPU kernel"),
+        reference: Piece::Without(
+            "the mesh is its own definition; its invariants (counts, unit length, adjacency, \
+             nesting) are tested in steradian_core::cp::mesh",
+        ),
+        bound: Piece::Without("exact up to the f32 rounding of f64 positions"),
+        batch: None,
+        tables: &[],
+    },
+    KernelSpec {
+        name: "cp-query",
+        paper: Paper::Cp,
+        contract: r#"{"level": L in 0..=4, "values": [one per vertex], "dirs": [[x,y,z] non-zero, …]} -> {"values": [Σ ω_i v_i per dir, area weights of eq. 2–4]}"#,
+        eval: Piece::At(handlers::cp_query),
+        scalar: "steradian_core::cp::mesh::Icosphere::query",
+        simd: Piece::Without("not written yet"),
+        wgsl: Piece::Without("not written yet"),
+        reference: Piece::At("steradian_reference::cp::locate"),
+        bound: Piece::At(Bound {
+            metric: "abs weight error",
+            item: "steradian_core::cp::mesh::WEIGHT_ABS_ERROR",
+            value: Some(steradian_core::cp::WEIGHT_ABS_ERROR as f64),
         }),
         batch: None,
         tables: &[],

@@ -5,6 +5,7 @@
 mod brdf;
 mod common;
 mod coverage;
+mod cp;
 mod cycles;
 mod env;
 mod fuzz_replay;

@@ -15,7 +15,7 @@
 
 mod mesh;
 
-pub use mesh::{Icosphere, Location, MAX_LEVEL, Weights};
+pub use mesh::{Icosphere, Location, MAX_LEVEL, WEIGHT_ABS_ERROR, Weights};
 
 /// The local deformation of section 3.3, eq. 8: raise the interpolated value at the
 /// direction of `at` by `delta` by moving only its three control points,
@@ -27,7 +27,7 @@ pub use mesh::{Icosphere, Location, MAX_LEVEL, Weights};
 /// exactly `r + δr`, which the test `deform_is_exact_at_its_point` asserts).
 pub fn deform(values: &mut [f32], at: &Location, delta: f32) {
     let s: f32 = at.weights.iter().map(|w| w * w).sum();
-    if !(s > 0.0) || !delta.is_finite() {
+    if s.is_nan() || s <= 0.0 || !delta.is_finite() {
         return;
     }
     for (v, w) in at.vertices.iter().zip(at.weights) {
