@@ -131,13 +131,7 @@ pub fn cp_vertices(obj: &Map<String, Value>) -> Result<Value, String> {
 /// `{"values": [one per direction]}`, with the paper's area weights.
 pub fn cp_query(obj: &Map<String, Value>) -> Result<Value, String> {
     let mesh = cp_level(obj)?;
-    let values: Vec<f32> = crate::json::field(obj, "values")?
-        .as_array()
-        .ok_or_else(|| "values must be an array of numbers".to_string())?
-        .iter()
-        .enumerate()
-        .map(|(i, v)| crate::json::element_f32(v, &format!("values[{i}]")))
-        .collect::<Result<_, _>>()?;
+    let values = crate::json::numbers(obj, "values")?;
     mesh.check(&values).map_err(|e| e.to_string())?;
     let dirs = crate::json::field(obj, "dirs")?
         .as_array()

@@ -120,17 +120,22 @@ pub fn element_f32(v: &Value, what: &str) -> Result<f32, String> {
     )
 }
 
+/// Field `name` as a list of finite `f32`s; an element that is not one is named
+/// (`values[3] must be a number, got "x"`).
+pub fn numbers(obj: &Map<String, Value>, name: &str) -> Result<Vec<f32>, String> {
+    field(obj, name)?
+        .as_array()
+        .ok_or_else(|| format!("{name} must be an array of numbers"))?
+        .iter()
+        .enumerate()
+        .map(|(i, v)| element_f32(v, &format!("{name}[{i}]")))
+        .collect()
+}
+
 /// Field `"coeffs"` as an SH coefficient vector: finite `f32`s, `n²` of them for a band count
 /// `n` in `1..=max`. Returns the values and `n`.
 pub fn sh_coeffs(obj: &Map<String, Value>, max: usize) -> Result<(Vec<f32>, usize), String> {
-    let list = field(obj, "coeffs")?
-        .as_array()
-        .ok_or_else(|| "coeffs must be an array of numbers".to_string())?;
-    let c: Vec<f32> = list
-        .iter()
-        .enumerate()
-        .map(|(i, v)| element_f32(v, &format!("coeffs[{i}]")))
-        .collect::<Result<_, _>>()?;
+    let c = numbers(obj, "coeffs")?;
     let n = (c.len() as f64).sqrt() as usize;
     if n * n != c.len() || n == 0 || n > max {
         return Err(format!(

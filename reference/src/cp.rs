@@ -18,8 +18,9 @@ fn unit(d: [f64; 3]) -> [f64; 3] {
     [d[0] / l, d[1] / l, d[2] / l]
 }
 
-/// Solid angle of the spherical triangle of unit vectors `(a, b, c)`, by Girard's theorem
-/// in `f64` through the Van Oosterom–Strackee form `2·atan2(|a·(b×c)|, 1 + a·b + b·c + c·a)`.
+/// Solid angle of the spherical triangle of unit vectors `(a, b, c)` in `f64`, by the
+/// Van Oosterom–Strackee form `2·atan2(|a·(b×c)|, 1 + a·b + b·c + c·a)` with the plain
+/// triple product (core takes it on edge differences).
 pub fn triangle_area(a: [f64; 3], b: [f64; 3], c: [f64; 3]) -> f64 {
     let det = dot(a, cross(b, c)).abs();
     2.0 * det.atan2(1.0 + dot(a, b) + dot(b, c) + dot(c, a))
