@@ -441,7 +441,7 @@ pub const KERNELS: &[KernelSpec] = &[
         contract: r#"{"level": L in 0..=4, "values": [one per vertex], "dirs": [[x,y,z] non-zero, …]} -> {"values": [Σ ω_i v_i per dir, area weights of eq. 2–4]}"#,
         eval: Piece::At(handlers::cp_query),
         scalar: "steradian_core::cp::mesh::Icosphere::query",
-        simd: Piece::Without("not written yet"),
+        simd: Piece::At("steradian_simd::cp::query_slices"),
         wgsl: Piece::Without("not written yet"),
         reference: Piece::At("steradian_reference::cp::locate"),
         bound: Piece::At(Bound {

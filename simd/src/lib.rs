@@ -13,9 +13,10 @@
 //! | [`rsl::sat`] | [`rsl::sat::box_sum`], [`rsl::sat::square`] | `box_sum_slices`, `square_slices` | bit-identical |
 //! | [`rsl::vdt`] | [`rsl::vdt::query`] | `query_slices` | bit-identical |
 //! | [`sh`] | [`sh::eval_x4`] (four directions, `f64` lanes as the scalar kernel) | `eval_slices` | bit-identical |
+//! | [`cp`] | (one function at many directions) | [`cp::query_slices`] | bit-identical (gnomonic weights), within [`cp::AREA_TOL`] (area weights) |
 //! | [`rsl::shade`] | [`rsl::shade::shade_x8`], [`rsl::shade::shade_moments_x8`] | `shade_batch`, `shade_moments_batch` | within [`rsl::shade::REL_TOL`], [`rsl::shade::MOMENTS_REL_TOL`] |
 //!
-//! The folders are those of `steradian-core`, one per paper (`lobe/`, `rsl/`, `sh/`).
+//! The folders are those of `steradian-core`, one per paper (`lobe/`, `rsl/`, `sh/`, `cp`).
 //!
 //! [`batch`] holds the lane types ([`Vec3x8`], [`Vec2x8`], [`LobeX8`]), their conversions
 //! from and to slices of the scalar types (a short slice is padded with a documented value),
@@ -84,6 +85,7 @@
 #![warn(missing_docs)]
 
 pub mod batch;
+pub mod cp;
 pub mod lobe;
 pub mod rsl;
 pub mod sh;

@@ -330,7 +330,7 @@ impl Icosphere {
             | (u.y.is_sign_negative() as usize) << 1
             | (u.z.is_sign_negative() as usize) << 2;
         // Canonical first-octant face P=(0,1,φ), Q=(φ,0,1), R=(1,φ,0), edge planes PQ, QR, RP.
-        let t = [a.dot(EDGE[0]), a.dot(EDGE[1]), a.dot(EDGE[2])];
+        let t = OCTANT_EDGES.map(|e| a.dot(e));
         let mut region = 0;
         let mut worst = 0.0f32;
         for (k, tk) in t.iter().enumerate() {
@@ -389,12 +389,7 @@ impl Icosphere {
     /// triangle that holds `d`. Errors: a wrong number of values, a zero or non-finite `d`.
     pub fn query(&self, values: &[f32], d: Vec3, weights: Weights) -> Result<f32, Error> {
         self.check(values)?;
-        let l = self.locate(d, weights)?;
-        Ok(l.vertices
-            .iter()
-            .zip(l.weights)
-            .map(|(v, w)| w * values[*v as usize])
-            .sum())
+        Ok(self.locate(d, weights)?.interpolate(values))
     }
 
     /// Checks that `values` has one entry per vertex.
@@ -414,11 +409,76 @@ impl Icosphere {
     pub fn base_faces(&self) -> &[[Vec3; 3]; 20] {
         &self.faces
     }
+
+    /// Per base face `[A, B, C]`, the plane normals `[B×C, C×A, A×B]` whose dot products
+    /// with a direction are its unnormalised gnomonic barycentrics (for the SIMD twin).
+    pub fn face_planes(&self) -> &[[Vec3; 3]; 20] {
+        &self.cross
+    }
+
+    /// The base face that holds a direction of octant `o` (bit 0: x < 0, bit 1: y < 0,
+    /// bit 2: z < 0) in region `r` (0: inside the octant's own face, `k + 1`: across
+    /// canonical edge `k` of [`OCTANT_EDGES`]). Both indices are taken modulo their range.
+    pub fn octant_face(&self, o: usize, r: usize) -> usize {
+        self.octant[o & 7][r & 3] as usize
+    }
+
+    /// The vertex at grid point `(i, j)` (`i + j ≤ 2^L`) of base face `f`, or `u32::MAX`
+    /// outside the grid.
+    pub fn grid_vertex(&self, f: usize, i: usize, j: usize) -> u32 {
+        let side = (1usize << self.level) + 1;
+        if f >= 20 || i >= side || j >= side {
+            return u32::MAX;
+        }
+        self.grid[f * side * side + j * side + i]
+    }
+
+    /// One direction against many functions (the direction-driven transport of the paper's
+    /// section 3.5 shares the weights along a ray): `out[k]` is the function of
+    /// `values[k·V..(k + 1)·V]` at `d`, `V` the vertex count. Located once.
+    /// Errors: `values.len() != out.len()·V`, a zero or non-finite `d`.
+    pub fn query_many(
+        &self,
+        values: &[f32],
+        d: Vec3,
+        weights: Weights,
+        out: &mut [f32],
+    ) -> Result<(), Error> {
+        let nv = self.vertices.len();
+        if values.len() != out.len() * nv {
+            return Err(Error::OutOfRange {
+                what: "number of values",
+                value: values.len() as f32,
+                min: (out.len() * nv) as f32,
+                max: (out.len() * nv) as f32,
+            });
+        }
+        let l = self.locate(d, weights)?;
+        for (o, f) in out.iter_mut().zip(values.chunks_exact(nv)) {
+            *o = l.interpolate(f);
+        }
+        Ok(())
+    }
 }
 
-/// The canonical edge normals `P×Q, Q×R, R×P` of the first octant's face, scaled (only the
-/// sign of the dot product matters).
-const EDGE: [Vec3; 3] = {
+impl Location {
+    /// `Σ ω_i v_i` for one value per vertex (`values` indexed by vertex; an index past its
+    /// end reads 0).
+    pub fn interpolate(&self, values: &[f32]) -> f32 {
+        let v = |k: usize| {
+            values
+                .get(self.vertices[k] as usize)
+                .copied()
+                .unwrap_or(0.0)
+        };
+        self.weights[0] * v(0) + self.weights[1] * v(1) + self.weights[2] * v(2)
+    }
+}
+
+/// The canonical edge normals `P×Q, Q×R, R×P` of the first octant's face, unnormalised
+/// (only the sign of the dot product matters): a direction `|d|` (componentwise absolute
+/// value) is across edge `k` where its dot product with entry `k` is negative.
+pub const OCTANT_EDGES: [Vec3; 3] = {
     // P=(0,1,φ), Q=(φ,0,1), R=(1,φ,0) unnormalised; φ = 1.6180339887.
     let f = 1.618_034_f32;
     [
