@@ -782,4 +782,28 @@ mod tests {
             assert!((a - b).abs() < 2e-2, "{a} vs {b}");
         }
     }
+
+    #[test]
+    fn query_many_equals_one_query_per_function() {
+        let m = Icosphere::new(2).unwrap();
+        let nv = m.vertices().len();
+        let values: Vec<f32> = (0..3 * nv).map(|k| (k as f32 * 0.37).sin()).collect();
+        let d = Vec3::new(0.3, -0.8, 0.2);
+        let mut out = [0.0f32; 3];
+        m.query_many(&values, d, Weights::Area, &mut out).unwrap();
+        for (k, o) in out.iter().enumerate() {
+            let one = m
+                .query(&values[k * nv..(k + 1) * nv], d, Weights::Area)
+                .unwrap();
+            assert_eq!(*o, one);
+        }
+        assert!(
+            m.query_many(&values[1..], d, Weights::Area, &mut out)
+                .is_err()
+        );
+        assert!(
+            m.query_many(&values, Vec3::ZERO, Weights::Area, &mut out)
+                .is_err()
+        );
+    }
 }
