@@ -85,6 +85,7 @@
 #![warn(missing_docs)]
 
 pub mod batch;
+#[cfg(feature = "alloc")]
 pub mod cp;
 pub mod lobe;
 pub mod rsl;
