@@ -3,11 +3,12 @@
 //!
 //! [`query_slices`] evaluates one function (one value per vertex) at many directions. The
 //! arithmetic runs on lanes with the scalar kernel's operations in its order: the
-//! normalisation by the largest component, the three octant-edge tests, the gnomonic
-//! barycentrics on the base face's plane, the grid cell (`floor` written as `−ceil(−x)`,
-//! exact), the gnomonic weights, and for the area weights the Van Oosterom–Strackee triple
-//! products and denominators. `wide` has no gather: the octant's face, the face's plane
-//! normals, the three vertices and their values are read by scalar indexing per lane.
+//! normalisation by the largest component, the gnomonic barycentrics on the base face's
+//! plane, the grid cell (`floor` written as `−ceil(−x)`, exact), the gnomonic weights, and
+//! for the area weights the Van Oosterom–Strackee triple products and denominators. `wide`
+//! has no gather: the base face (the scalar `Icosphere::base_face` of each lane's unit
+//! direction), the face's plane normals, the three vertices and their values are read per
+//! lane.
 //!
 //! - [`Weights::Gnomonic`]: only correctly rounded operations, so every lane is
 //!   **bit-identical** to the scalar query.
@@ -17,7 +18,7 @@
 //!
 //! A lane whose direction is zero or not finite (where the scalar query is an error) is NaN.
 
-use steradian_core::cp::{Icosphere, OCTANT_EDGES, Weights};
+use steradian_core::cp::{Icosphere, Weights};
 use steradian_core::{Error, Vec3};
 
 use crate::lanes::{ColumnKernel, Lanes, SliceVec, drive, max_num};
@@ -84,25 +85,15 @@ impl ColumnKernel<3, 1> for Query<'_> {
         let s = [x / m, y / m, z / m];
         let len = dot(s, s).sqrt();
         let u = s.map(|c| bad.select(one, c / len));
-        let a = u.map(|c| c.abs());
-        // Octant and region, per lane (integer work).
-        let e = OCTANT_EDGES.map(|v| [W::splat(v.x), W::splat(v.y), W::splat(v.z)]);
-        let t = [dot(a, e[0]), dot(a, e[1]), dot(a, e[2])];
-        let mut face = [0usize; 16];
-        for (k, f) in face.iter_mut().take(W::N).enumerate() {
-            let o = (u[0].lanes()[k].is_sign_negative() as usize)
-                | (u[1].lanes()[k].is_sign_negative() as usize) << 1
-                | (u[2].lanes()[k].is_sign_negative() as usize) << 2;
-            let mut region = 0;
-            let mut worst = 0.0f32;
-            for (r, tr) in t.iter().enumerate() {
-                if tr.lanes()[k] < worst {
-                    worst = tr.lanes()[k];
-                    region = r + 1;
-                }
+        // The base face, per lane (the scalar kernel's sign and edge-plane tests).
+        let face: [usize; 16] = core::array::from_fn(|k| {
+            if k < W::N {
+                let l = |c: usize| u[c].lanes()[k];
+                self.mesh.base_face(Vec3::new(l(0), l(1), l(2)))
+            } else {
+                0
             }
-            *f = self.mesh.octant_face(o, region);
-        }
+        });
         let planes = self.mesh.face_planes();
         let plane = |p: usize| -> [W; 3] {
             [

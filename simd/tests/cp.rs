@@ -11,7 +11,7 @@ use steradian_simd::cp::{AREA_TOL, query_slices};
 
 use crate::common::lanes::{LENGTHS, in_every_lane, same};
 use crate::common::rng::Rng;
-use crate::common::specials::SPECIALS;
+use crate::common::specials::{SPECIALS, in_each_component};
 
 fn meshes() -> Vec<(Icosphere, Vec<f32>)> {
     let mut rng = Rng(0x5eed_0c90);
@@ -88,18 +88,12 @@ fn arbitrary_bit_patterns() {
 
 #[test]
 fn special_values_in_every_component_and_lane() {
-    let rows: Vec<Vec3> = SPECIALS
-        .iter()
-        .flat_map(|&s| {
-            [
-                Vec3::new(s, 0.3, 0.4),
-                Vec3::new(0.3, s, 0.4),
-                Vec3::new(0.3, 0.4, s),
-                Vec3::splat(s),
-                Vec3::new(s, -s, 0.0),
-            ]
-        })
-        .collect();
+    let mut rows = in_each_component();
+    rows.extend(
+        SPECIALS
+            .iter()
+            .flat_map(|&s| [Vec3::splat(s), Vec3::new(s, -s, 0.0)]),
+    );
     for (m, v) in meshes() {
         for w in BOTH {
             in_every_lane(&rows, Vec3::X, |r| check(&m, &v, r, w));

@@ -9,7 +9,7 @@ use steradian_simd::sh::{eval_slices, eval_x4};
 
 use crate::common::lanes::{LENGTHS, in_every_lane, same};
 use crate::common::rng::Rng;
-use crate::common::specials::SPECIALS;
+use crate::common::specials::{SPECIALS, in_each_component};
 
 fn scalar(d: Vec3, bands: usize) -> Vec<f32> {
     let mut out = vec![0.0; bands * bands];
@@ -51,15 +51,8 @@ fn random_directions_every_length_and_band_count() {
 
 #[test]
 fn special_values_in_every_component_and_lane() {
-    let rows: Vec<Vec3> = SPECIALS
-        .iter()
-        .flat_map(|&s| {
-            [
-                Vec3::new(s, 0.3, 0.4),
-                Vec3::new(0.3, s, 0.4),
-                Vec3::new(0.3, 0.4, s),
-            ]
-        })
+    let rows: Vec<Vec3> = in_each_component()
+        .into_iter()
         .chain([
             Vec3::Z,
             -Vec3::Z,

@@ -325,21 +325,7 @@ impl Icosphere {
     /// documented on it).
     pub fn locate(&self, d: Vec3, weights: Weights) -> Result<Location, Error> {
         let u = unit(d)?;
-        let a = u.abs();
-        let o = (u.x.is_sign_negative() as usize)
-            | (u.y.is_sign_negative() as usize) << 1
-            | (u.z.is_sign_negative() as usize) << 2;
-        // Canonical first-octant face P=(0,1,φ), Q=(φ,0,1), R=(1,φ,0), edge planes PQ, QR, RP.
-        let t = OCTANT_EDGES.map(|e| a.dot(e));
-        let mut region = 0;
-        let mut worst = 0.0f32;
-        for (k, tk) in t.iter().enumerate() {
-            if *tk < worst {
-                worst = *tk;
-                region = k + 1;
-            }
-        }
-        let f = self.octant[o][region] as usize;
+        let f = self.base_face(u);
         let c = &self.cross[f];
         let b = [u.dot(c[0]), u.dot(c[1]), u.dot(c[2])];
         let s = b[0] + b[1] + b[2];
@@ -416,11 +402,25 @@ impl Icosphere {
         &self.cross
     }
 
-    /// The base face that holds a direction of octant `o` (bit 0: x < 0, bit 1: y < 0,
-    /// bit 2: z < 0) in region `r` (0: inside the octant's own face, `k + 1`: across
-    /// canonical edge `k` of [`OCTANT_EDGES`]). Both indices are taken modulo their range.
-    pub fn octant_face(&self, o: usize, r: usize) -> usize {
-        self.octant[o & 7][r & 3] as usize
+    /// The base face that holds the unit direction `u`: the octant face of `u`'s signs (bit 0:
+    /// x < 0, bit 1: y < 0, bit 2: z < 0), or its neighbour across the canonical edge whose
+    /// plane `|u|` is farthest behind (at most one is behind inside an octant, up to
+    /// rounding on the face's corners, where both faces hold `u`).
+    pub fn base_face(&self, u: Vec3) -> usize {
+        let a = u.abs();
+        let o = (u.x.is_sign_negative() as usize)
+            | (u.y.is_sign_negative() as usize) << 1
+            | (u.z.is_sign_negative() as usize) << 2;
+        let mut region = 0;
+        let mut worst = 0.0f32;
+        for (k, e) in OCTANT_EDGES.iter().enumerate() {
+            let t = a.dot(*e);
+            if t < worst {
+                worst = t;
+                region = k + 1;
+            }
+        }
+        self.octant[o][region] as usize
     }
 
     /// The vertex at grid point `(i, j)` (`i + j ≤ 2^L`) of base face `f`, or `u32::MAX`
@@ -478,7 +478,7 @@ impl Location {
 /// The canonical edge normals `P×Q, Q×R, R×P` of the first octant's face, unnormalised
 /// (only the sign of the dot product matters): a direction `|d|` (componentwise absolute
 /// value) is across edge `k` where its dot product with entry `k` is negative.
-pub const OCTANT_EDGES: [Vec3; 3] = {
+const OCTANT_EDGES: [Vec3; 3] = {
     // P=(0,1,φ), Q=(φ,0,1), R=(1,φ,0) unnormalised; φ = 1.6180339887.
     let f = 1.618_034_f32;
     [

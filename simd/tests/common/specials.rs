@@ -30,3 +30,18 @@ pub const SPECIALS: [f32; 27] = [
     3.0,
     1e5,
 ];
+
+/// Directions with each special value in each component of `(0.3, 0.4)`-filled rows: three
+/// rows per value, the special in x, in y and in z.
+pub fn in_each_component() -> Vec<glam::Vec3> {
+    SPECIALS
+        .iter()
+        .flat_map(|&s| {
+            [
+                glam::Vec3::new(s, 0.3, 0.4),
+                glam::Vec3::new(0.3, s, 0.4),
+                glam::Vec3::new(0.3, 0.4, s),
+            ]
+        })
+        .collect()
+}
