@@ -6,9 +6,9 @@
 //! normalisation by the largest component, the gnomonic barycentrics on the base face's
 //! plane, the grid cell (`floor` written as `−ceil(−x)`, exact), the gnomonic weights, and
 //! for the area weights the Van Oosterom–Strackee triple products and denominators. `wide`
-//! has no gather: the base face (the scalar `Icosphere::base_face` of each lane's unit
-//! direction), the face's plane normals, the three vertices and their values are read per
-//! lane.
+//! has no gather: the region (which canonical edge plane `|u|` is behind) is found
+//! lane-wise, then one pass per lane reads the face (`Icosphere::octant_face`) and its plane
+//! normals, and a second the three vertices, their values and positions.
 //!
 //! - [`Weights::Gnomonic`]: only correctly rounded operations, so every lane is
 //!   **bit-identical** to the scalar query.
@@ -18,7 +18,7 @@
 //!
 //! A lane whose direction is zero or not finite (where the scalar query is an error) is NaN.
 
-use steradian_core::cp::{Icosphere, Weights};
+use steradian_core::cp::{Icosphere, OCTANT_EDGES, Weights};
 use steradian_core::{Error, Vec3};
 
 use crate::lanes::{ColumnKernel, Lanes, SliceVec, drive, max_num};
@@ -85,21 +85,39 @@ impl ColumnKernel<3, 1> for Query<'_> {
         let s = [x / m, y / m, z / m];
         let len = dot(s, s).sqrt();
         let u = s.map(|c| bad.select(one, c / len));
-        // The base face, per lane (the scalar kernel's sign and edge-plane tests).
-        let face: [usize; 16] = core::array::from_fn(|k| {
-            if k < W::N {
-                let l = |c: usize| u[c].lanes()[k];
-                self.mesh.base_face(Vec3::new(l(0), l(1), l(2)))
-            } else {
-                0
-            }
-        });
+        // The region, lane-wise: the scalar `base_face`'s running minimum over the three
+        // canonical edge planes of |u|.
+        let a = u.map(|c| c.abs());
+        let mut region = zero;
+        let mut worst = zero;
+        for (k, e) in OCTANT_EDGES.iter().enumerate() {
+            let t = dot(a, [W::splat(e.x), W::splat(e.y), W::splat(e.z)]);
+            let m = t.lt(worst);
+            region = m.select(W::splat((k + 1) as f32), region);
+            worst = m.select(t, worst);
+        }
+        // Per lane: the octant's sign bits, the face, and its plane normals, in one pass.
         let planes = self.mesh.face_planes();
+        let mut face = [0usize; 16];
+        let mut pl = [[0.0f32; 16]; 9];
+        let (ul, rl) = ([u[0].lanes(), u[1].lanes(), u[2].lanes()], region.lanes());
+        for k in 0..W::N {
+            let o = (ul[0][k].is_sign_negative() as usize)
+                | (ul[1][k].is_sign_negative() as usize) << 1
+                | (ul[2][k].is_sign_negative() as usize) << 2;
+            let f = self.mesh.octant_face(o, rl[k] as usize);
+            face[k] = f;
+            for (p, n) in planes[f].iter().enumerate() {
+                pl[3 * p][k] = n.x;
+                pl[3 * p + 1][k] = n.y;
+                pl[3 * p + 2][k] = n.z;
+            }
+        }
         let plane = |p: usize| -> [W; 3] {
             [
-                W::from_fn(|k| planes[face[k]][p].x),
-                W::from_fn(|k| planes[face[k]][p].y),
-                W::from_fn(|k| planes[face[k]][p].z),
+                W::load(&pl[3 * p][..W::N]),
+                W::load(&pl[3 * p + 1][..W::N]),
+                W::load(&pl[3 * p + 2][..W::N]),
             ]
         };
         let b = [dot(u, plane(0)), dot(u, plane(1)), dot(u, plane(2))];
@@ -113,18 +131,29 @@ impl ColumnKernel<3, 1> for Query<'_> {
         let j = (-(-gy).ceil()).fast_min(top - i);
         let (fx, fy) = (gx - i, gy - j);
         let up = (fx + fy).le(one) | (i + j + one).eq(n);
-        // The triangle's vertices, per lane.
-        let mut ids = [[0u32; 16]; 3];
+        // Per lane: the triangle's vertices, their values and (for the area weights) their
+        // positions, in one pass.
+        let verts = self.mesh.vertices();
+        let need_positions = self.weights == Weights::Area;
+        let mut vals = [[0.0f32; 16]; 3];
+        let mut pos = [[0.0f32; 16]; 9];
+        let (il, jl, upl) = (i.lanes(), j.lanes(), up.lanes());
         for k in 0..W::N {
-            let (ii, jj) = (i.lanes()[k] as usize, j.lanes()[k] as usize);
+            let (ii, jj) = (il[k] as usize, jl[k] as usize);
             let g = |di: usize, dj: usize| self.mesh.grid_vertex(face[k], ii + di, jj + dj);
-            let v = if up.lanes()[k].to_bits() != 0 {
+            let v = if upl[k].to_bits() != 0 {
                 [g(0, 0), g(1, 0), g(0, 1)]
             } else {
                 [g(1, 0), g(1, 1), g(0, 1)]
             };
             for (c, id) in v.into_iter().enumerate() {
-                ids[c][k] = id;
+                vals[c][k] = self.values.get(id as usize).copied().unwrap_or(0.0);
+                if need_positions {
+                    let p = verts.get(id as usize).copied().unwrap_or(Vec3::Z);
+                    pos[3 * c][k] = p.x;
+                    pos[3 * c + 1][k] = p.y;
+                    pos[3 * c + 2][k] = p.z;
+                }
             }
         }
         let w = match self.weights {
@@ -134,13 +163,11 @@ impl ColumnKernel<3, 1> for Query<'_> {
                 max_num(up.select(fy, one - fx), zero),
             ]),
             Weights::Area => {
-                let verts = self.mesh.vertices();
                 let at = |c: usize| -> [W; 3] {
-                    let p = |k: usize| verts.get(ids[c][k] as usize).copied().unwrap_or(Vec3::Z);
                     [
-                        W::from_fn(|k| p(k).x),
-                        W::from_fn(|k| p(k).y),
-                        W::from_fn(|k| p(k).z),
+                        W::load(&pos[3 * c][..W::N]),
+                        W::load(&pos[3 * c + 1][..W::N]),
+                        W::load(&pos[3 * c + 2][..W::N]),
                     ]
                 };
                 let v = [at(0), at(1), at(2)];
@@ -151,8 +178,7 @@ impl ColumnKernel<3, 1> for Query<'_> {
                 ])
             }
         };
-        let val =
-            |c: usize| W::from_fn(|k| self.values.get(ids[c][k] as usize).copied().unwrap_or(0.0));
+        let val = |c: usize| W::load(&vals[c][..W::N]);
         let r = w[0] * val(0) + w[1] * val(1) + w[2] * val(2);
         ([bad.select(W::splat(f32::NAN), r)], zero)
     }

@@ -420,7 +420,15 @@ impl Icosphere {
                 region = k + 1;
             }
         }
-        self.octant[o][region] as usize
+        self.octant_face(o, region)
+    }
+
+    /// The base face of octant `o` (bit 0: x < 0, bit 1: y < 0, bit 2: z < 0) in region `r`
+    /// (0: the octant's own face, `k + 1`: across canonical edge `k` of [`OCTANT_EDGES`]), as
+    /// [`Self::base_face`] picks them (for the SIMD twin, which finds the region lane-wise).
+    /// Both indices are taken modulo their range.
+    pub fn octant_face(&self, o: usize, r: usize) -> usize {
+        self.octant[o & 7][r & 3] as usize
     }
 
     /// The vertex at grid point `(i, j)` (`i + j ≤ 2^L`) of base face `f`, or `u32::MAX`
@@ -478,7 +486,7 @@ impl Location {
 /// The canonical edge normals `P×Q, Q×R, R×P` of the first octant's face, unnormalised
 /// (only the sign of the dot product matters): a direction `|d|` (componentwise absolute
 /// value) is across edge `k` where its dot product with entry `k` is negative.
-const OCTANT_EDGES: [Vec3; 3] = {
+pub const OCTANT_EDGES: [Vec3; 3] = {
     // P=(0,1,φ), Q=(φ,0,1), R=(1,φ,0) unnormalised; φ = 1.6180339887.
     let f = 1.618_034_f32;
     [

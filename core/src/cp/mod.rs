@@ -15,7 +15,7 @@
 
 mod mesh;
 
-pub use mesh::{Icosphere, Location, MAX_LEVEL, WEIGHT_ABS_ERROR, Weights};
+pub use mesh::{Icosphere, Location, MAX_LEVEL, OCTANT_EDGES, WEIGHT_ABS_ERROR, Weights};
 
 /// The local deformation of section 3.3, eq. 8: raise the interpolated value at the
 /// direction of `at` by `delta` by moving only its three control points,
