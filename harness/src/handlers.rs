@@ -155,3 +155,34 @@ pub fn cp_query(obj: &Map<String, Value>) -> Result<Value, String> {
     }
     Ok(json!({ "values": out }))
 }
+
+/// `cp-fit`: `{"level": L, "samples": [[x, y, z, value], …]}` → `{"values": [one per
+/// vertex]}`, the least-squares minimiser of eq. 3 (`crate::cp::fit`; the undetermined
+/// components, if any, are 0).
+pub fn cp_fit(obj: &Map<String, Value>) -> Result<Value, String> {
+    let mesh = cp_level(obj)?;
+    let rows = crate::json::field(obj, "samples")?
+        .as_array()
+        .ok_or_else(|| "samples must be an array of [x, y, z, value]".to_string())?;
+    let mut samples = Vec::with_capacity(rows.len());
+    for (i, r) in rows.iter().enumerate() {
+        let s = r
+            .as_array()
+            .filter(|a| a.len() == 4)
+            .ok_or_else(|| format!("samples[{i}] must be [x, y, z, value]"))?;
+        let p: Vec<f32> = s
+            .iter()
+            .enumerate()
+            .map(|(k, v)| crate::json::element_f32(v, &format!("samples[{i}][{k}]")))
+            .collect::<Result<_, _>>()?;
+        if p[..3].iter().all(|c| *c == 0.0) {
+            return Err(format!("samples[{i}]: the direction is zero"));
+        }
+        samples.push([p[0], p[1], p[2], p[3]]);
+    }
+    let v = crate::cp::fit(&mesh, &samples)?;
+    if let Some(k) = v.iter().position(|x| x.abs() > f64::from(f32::MAX)) {
+        return Err(format!("the fit's value {k} overflows f32 ({})", v[k]));
+    }
+    Ok(json!({ "values": v.into_iter().map(|x| num(x as f32)).collect::<Vec<_>>() }))
+}

@@ -7,6 +7,7 @@
 pub mod accuracy;
 pub mod backend;
 pub mod batch;
+pub mod cp;
 pub mod env;
 pub mod eval;
 pub mod generate;

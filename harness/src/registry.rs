@@ -452,6 +452,26 @@ pub const KERNELS: &[KernelSpec] = &[
         batch: None,
         tables: &[],
     },
+    KernelSpec {
+        name: "cp-fit",
+        paper: Paper::Cp,
+        contract: r#"{"level": L in 0..=4, "samples": [[x,y,z,value] non-zero direction, …]} -> {"values": [one per vertex: a minimiser of Σ (query(d_s) − value_s)², undetermined components 0]}"#,
+        eval: Piece::At(handlers::cp_fit),
+        scalar: "steradian_core::cp::fit::Design::gram",
+        simd: Piece::Without(
+            "assembled once per direction set and factored by a sparse Cholesky; the query \
+             it fits for has the SIMD twin",
+        ),
+        wgsl: Piece::Without("a factorisation on the CPU, not a GPU kernel"),
+        reference: Piece::At("steradian_harness::cp::fit_dense_reference"),
+        bound: Piece::At(Bound {
+            metric: "excess residual / ‖f‖",
+            item: "steradian_harness::cp::RESIDUAL_REL_ERROR",
+            value: Some(crate::cp::RESIDUAL_REL_ERROR),
+        }),
+        batch: None,
+        tables: &[],
+    },
 ];
 
 /// The kernel named `name`.

@@ -99,3 +99,199 @@ fn query_matches_the_brute_force_interpolation() {
         assert!(e.is_err(), "{b}");
     }
 }
+
+/// Directions on a spiral, scaled to length `len` (the fit normalises them).
+fn spiral(n: usize, len: f64) -> Vec<[f64; 3]> {
+    (0..n)
+        .map(|i| {
+            let t = i as f64 * 2.399_963;
+            let z = 1.0 - 2.0 * (i as f64 + 0.5) / n as f64;
+            let r = (1.0 - z * z).sqrt();
+            [r * t.cos() * len, r * t.sin() * len, z * len]
+        })
+        .collect()
+}
+
+fn fit_line(level: u32, samples: &[[f64; 4]]) -> Result<Vec<f64>, String> {
+    let line = json!({ "level": level, "samples": samples }).to_string();
+    let out = eval_line("cp-fit", &line)?;
+    Ok(out["values"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|x| x.as_f64().unwrap())
+        .collect())
+}
+
+fn design(level: u32, samples: &[[f64; 4]]) -> steradian_core::cp::Design {
+    let mesh = steradian_core::cp::Icosphere::new(level).unwrap();
+    let dirs: Vec<steradian_core::Vec3> = samples
+        .iter()
+        .map(|s| steradian_core::Vec3::new(s[0] as f32, s[1] as f32, s[2] as f32))
+        .collect();
+    steradian_core::cp::Design::new(&mesh, &dirs).unwrap()
+}
+
+#[test]
+fn fit_recovers_a_function_the_mesh_represents() {
+    // Samples of the interpolant of known values: the least-squares minimiser is those
+    // values (every triangle holds samples enough to pin its three vertices).
+    let level = 2;
+    let mesh = steradian_core::cp::Icosphere::new(level).unwrap();
+    let truth: Vec<f32> = (0..mesh.vertices().len())
+        .map(|k| ((k * 37 % 101) as f32 / 50.0) - 1.0)
+        .collect();
+    let samples: Vec<[f64; 4]> = spiral(4000, 3.0)
+        .into_iter()
+        .map(|d| {
+            let v = mesh
+                .query(
+                    &truth,
+                    steradian_core::Vec3::new(d[0] as f32, d[1] as f32, d[2] as f32),
+                    steradian_core::cp::Weights::Area,
+                )
+                .unwrap();
+            [d[0], d[1], d[2], f64::from(v)]
+        })
+        .collect();
+    let got = fit_line(level, &samples).unwrap();
+    for (k, (g, t)) in got.iter().zip(&truth).enumerate() {
+        assert!((g - f64::from(*t)).abs() < 2e-5, "vertex {k}: {g} vs {t}");
+    }
+}
+
+#[test]
+fn fit_residual_equals_the_svd_minimisers() {
+    use steradian_harness::cp::{RESIDUAL_REL_ERROR, fit_dense_reference, residual};
+    // A Phong-like lobe the mesh does not represent, on sample sets that over-determine,
+    // barely determine and under-determine the values; the dense SVD pseudo-inverse is an
+    // exact minimiser.
+    let f = |d: [f64; 3]| {
+        let l = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
+        (0.3 * d[0] + 0.5 * d[1] + 0.81 * d[2]).max(0.0).powi(8) / l.powi(8) + 0.1
+    };
+    let vertex_samples = |level: u32| -> Vec<[f64; 4]> {
+        vertices(level)
+            .into_iter()
+            .map(|p| [p[0], p[1], p[2], f(p)])
+            .collect()
+    };
+    let cases: Vec<(&str, u32, Vec<[f64; 4]>)> = vec![
+        (
+            "2000 samples, level 1",
+            1,
+            spiral(2000, 1.0)
+                .into_iter()
+                .map(|d| [d[0], d[1], d[2], f(d)])
+                .collect(),
+        ),
+        (
+            "3000 samples, level 2",
+            2,
+            spiral(3000, 0.01)
+                .into_iter()
+                .map(|d| [d[0], d[1], d[2], f(d)])
+                .collect(),
+        ),
+        (
+            "30 samples, level 2 (under-determined)",
+            2,
+            spiral(30, 1.0)
+                .into_iter()
+                .map(|d| [d[0], d[1], d[2], f(d)])
+                .collect(),
+        ),
+        ("one sample per vertex, level 2", 2, vertex_samples(2)),
+        (
+            "the same direction twice with different values, level 0",
+            0,
+            vec![
+                [0.2, 0.3, 0.9, 1.0],
+                [0.2, 0.3, 0.9, 3.0],
+                [-1.0, 0.1, 0.0, 2.0],
+            ],
+        ),
+    ];
+    for (name, level, samples) in cases {
+        let got = fit_line(level, &samples).unwrap();
+        let d = design(level, &samples);
+        let values: Vec<f64> = samples.iter().map(|s| s[3] as f32 as f64).collect();
+        let want = fit_dense_reference(&d, &values);
+        let norm = values.iter().map(|v| v * v).sum::<f64>().sqrt();
+        // The fit's values are printed in f32: compare residuals at f32-rounded values of
+        // both, so that the rounding is not counted as excess.
+        let round = |v: &[f64]| -> Vec<f64> { v.iter().map(|x| *x as f32 as f64).collect() };
+        let (r_got, r_want) = (
+            residual(&d, &got, &values),
+            residual(&d, &round(&want), &values),
+        );
+        let exact = residual(&d, &want, &values);
+        // The f64 fit itself: its excess residual is within the bound.
+        let mesh = steradian_core::cp::Icosphere::new(level).unwrap();
+        let rows: Vec<[f32; 4]> = samples.iter().map(|s| s.map(|x| x as f32)).collect();
+        let inner = steradian_harness::cp::fit(&mesh, &rows).unwrap();
+        let excess = (residual(&d, &inner, &values) - exact) / norm;
+        assert!(
+            excess <= RESIDUAL_REL_ERROR,
+            "{name}: excess residual {excess:.2e} of ‖f‖"
+        );
+        // The printed (f32) values: no worse than the minimiser's rounded to f32, up to the
+        // same bound.
+        assert!(
+            r_got - exact <= RESIDUAL_REL_ERROR * norm + 2.0 * (r_want - exact).abs() + 1e-12,
+            "{name}: residual {r_got} against the minimiser's {exact} (f32-rounded {r_want})"
+        );
+        // Components the samples do not touch are zero.
+        let touched: std::collections::HashSet<u32> =
+            d.rows().iter().flat_map(|r| r.vertices).collect();
+        for (k, v) in got.iter().enumerate() {
+            if !touched.contains(&(k as u32)) {
+                assert_eq!(*v, 0.0, "{name}: untouched vertex {k} is {v}");
+            }
+        }
+    }
+}
+
+#[test]
+fn fit_at_level_4_solves_the_normal_equations() {
+    // No dense reference at 2562 unknowns: the gradient Aᵀ(A v − f) of the residual vanishes
+    // at a minimiser (relative to ‖Aᵀf‖).
+    let level = 4;
+    let samples: Vec<[f64; 4]> = spiral(20_000, 1.0)
+        .into_iter()
+        .map(|d| [d[0], d[1], d[2], (5.0 * d[0]).sin() * d[2] + d[1]])
+        .collect();
+    let mesh = steradian_core::cp::Icosphere::new(level).unwrap();
+    let rows: Vec<[f32; 4]> = samples.iter().map(|s| s.map(|x| x as f32)).collect();
+    let v = steradian_harness::cp::fit(&mesh, &rows).unwrap();
+    let d = design(level, &samples);
+    let values: Vec<f64> = rows.iter().map(|s| f64::from(s[3])).collect();
+    let av = d.apply(&v).unwrap();
+    let r: Vec<f64> = av.iter().zip(&values).map(|(a, f)| a - f).collect();
+    let grad = d.project(&r).unwrap();
+    let atf = d.project(&values).unwrap();
+    let n = |x: &[f64]| x.iter().map(|v| v * v).sum::<f64>().sqrt();
+    assert!(n(&grad) <= 1e-10 * n(&atf), "{} vs {}", n(&grad), n(&atf));
+}
+
+#[test]
+fn fit_bad_lines_and_edge_cases() {
+    // No samples: every vertex is undetermined, so 0.
+    let v = fit_line(1, &[]).unwrap();
+    assert_eq!(v, vec![0.0; 42]);
+    // Huge values stay finite and exact where determined.
+    let big = fit_line(0, &[[0.0, 0.0, 1.0, 1e38]]).unwrap();
+    assert!(big.iter().all(|x| x.is_finite()));
+    for bad in [
+        json!({ "level": 5, "samples": [] }),
+        json!({ "level": 0 }),
+        json!({ "level": 0, "samples": 3 }),
+        json!({ "level": 0, "samples": [[0, 0, 1]] }),
+        json!({ "level": 0, "samples": [[0, 0, 0, 1]] }),
+        json!({ "level": 0, "samples": [[0, 0, 1, "x"]] }),
+        json!({ "level": 0, "samples": [[0, 0, 1, 1e39]] }),
+    ] {
+        let e: Result<Value, String> = eval_line("cp-fit", &bad.to_string());
+        assert!(e.is_err(), "{bad}");
+    }
+}

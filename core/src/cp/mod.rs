@@ -10,11 +10,15 @@
 //!   [`Icosphere::vertices`]; [`Icosphere::query`] interpolates it, [`deform`] is the local
 //!   deformation of section 3.3 (eq. 8). Scale and add are the element-wise operations on
 //!   the values (the interpolation is linear in them).
+//! - [`fit::Design`] (`fit.rs`): the least-squares fit of eq. 3, as a design matrix and
+//!   its normal equations (factored by the harness).
 //!
 //! Requires the `alloc` feature (the mesh is built at run time, deterministically).
 
+pub mod fit;
 mod mesh;
 
+pub use fit::Design;
 pub use mesh::{Icosphere, Location, MAX_LEVEL, OCTANT_EDGES, WEIGHT_ABS_ERROR, Weights};
 
 /// The local deformation of section 3.3, eq. 8: raise the interpolated value at the
