@@ -179,3 +179,59 @@ pub fn residual(design: &Design, v: &[f64], values: &[f64]) -> f64 {
         })
         .unwrap_or(f64::NAN)
 }
+
+/// The brute-force query, the baseline of the O(1) location's speed: every triangle's three
+/// edge planes (precomputed in `f32`), the triangle whose nearest edge plane is farthest (a
+/// full scan of `20·4^L` triangles), then the area weights by the plain Van Oosterom–Strackee
+/// form.
+pub struct BruteForce<'a> {
+    mesh: &'a Icosphere,
+    planes: Vec<[Vec3; 3]>,
+}
+
+impl<'a> BruteForce<'a> {
+    /// The edge planes of every triangle of `mesh`.
+    pub fn new(mesh: &'a Icosphere) -> Self {
+        let v = mesh.vertices();
+        let planes = mesh
+            .triangles()
+            .iter()
+            .map(|t| {
+                let p = t.map(|k| v[k as usize]);
+                [
+                    p[1].cross(p[2]).normalize(),
+                    p[2].cross(p[0]).normalize(),
+                    p[0].cross(p[1]).normalize(),
+                ]
+            })
+            .collect();
+        Self { mesh, planes }
+    }
+
+    /// The function of `values` at `d` (non-zero, finite), by the scan.
+    pub fn query(&self, values: &[f32], d: Vec3) -> f32 {
+        let u = d.normalize();
+        let mut best = (f32::NEG_INFINITY, 0);
+        for (t, p) in self.planes.iter().enumerate() {
+            let m = u.dot(p[0]).min(u.dot(p[1])).min(u.dot(p[2]));
+            if m > best.0 {
+                best = (m, t);
+            }
+        }
+        let tri = self.mesh.triangles()[best.1];
+        let v = tri.map(|k| self.mesh.vertices()[k as usize]);
+        let area = |a: Vec3, b: Vec3, c: Vec3| {
+            2.0 * a
+                .dot(b.cross(c))
+                .abs()
+                .atan2(1.0 + a.dot(b) + b.dot(c) + c.dot(a))
+        };
+        let w = [
+            area(u, v[1], v[2]),
+            area(v[0], u, v[2]),
+            area(v[0], v[1], u),
+        ];
+        let s = w[0] + w[1] + w[2];
+        (0..3).map(|k| w[k] / s * values[tri[k] as usize]).sum()
+    }
+}

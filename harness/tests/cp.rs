@@ -295,3 +295,23 @@ fn fit_bad_lines_and_edge_cases() {
         assert!(e.is_err(), "{bad}");
     }
 }
+
+#[test]
+fn brute_force_baseline_agrees_with_the_o1_query() {
+    // The report's and the bench's speed baseline must answer the same question.
+    for level in 0..=3u32 {
+        let mesh = steradian_core::cp::Icosphere::new(level).unwrap();
+        let values: Vec<f32> = (0..mesh.vertices().len())
+            .map(|k| (k as f32 * 0.618).fract())
+            .collect();
+        let brute = steradian_harness::cp::BruteForce::new(&mesh);
+        for d in spiral(500, 2.0) {
+            let d = steradian_core::Vec3::new(d[0] as f32, d[1] as f32, d[2] as f32);
+            let a = mesh
+                .query(&values, d, steradian_core::cp::Weights::Area)
+                .unwrap();
+            let b = brute.query(&values, d);
+            assert!((a - b).abs() < 1e-5, "level {level}, {d}: {a} vs {b}");
+        }
+    }
+}

@@ -3,6 +3,7 @@
 //! `index.html` (tables and SVG speed-against-error plots) and a summary on stdout.
 
 pub mod brdf;
+pub mod cp;
 pub mod lobe_sum;
 pub mod plot;
 pub mod product;

@@ -16,6 +16,7 @@ pub const PRODUCERS: &[(&str, Producer)] = &[
     ("rsl", super::rsl::section),
     ("shade", super::shade::section),
     ("sh", super::sh::section),
+    ("control-points", super::cp::section),
     ("scenes", super::scenes::section),
 ];
 

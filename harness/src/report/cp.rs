@@ -1,0 +1,362 @@
+//! Report section: control-point spherical functions (Chatelier and Malgouyres, GRAPP 2007).
+//! Query throughput per subdivision level — the O(1) location with area and gnomonic
+//! weights, scalar and SIMD, against a brute-force scan of every triangle — in the same run;
+//! the measured difference between the two weights and the area weights' jump across
+//! triangle edges; and the least-squares fit's cost against its sample count.
+
+use std::error::Error;
+use std::fmt::Write as _;
+use std::hint::black_box;
+
+use serde_json::json;
+use steradian_core::Vec3;
+use steradian_core::cp::{Icosphere, MAX_LEVEL, Weights};
+use steradian_reference::cp as reference;
+
+use super::Options;
+use super::section::Section;
+use super::timing::{median_times_in_turns, ns_per, timed};
+use crate::cp::{BruteForce, LeastSquares};
+use crate::rng::Rng;
+
+const SEED: u64 = 0x0c90_5eed;
+/// Levels of the fit table and its sample counts.
+pub const FIT_LEVELS: [u32; 3] = [2, 3, 4];
+/// Sample counts of the fit table.
+pub const FIT_SAMPLES: [usize; 3] = [1_000, 10_000, 100_000];
+
+/// One level of the query table: ns per query.
+struct QueryRow {
+    level: u32,
+    scalar_area: f64,
+    scalar_gnomonic: f64,
+    simd_area: f64,
+    simd_gnomonic: f64,
+    brute_force: f64,
+}
+
+/// One level of the weight comparison.
+struct WeightRow {
+    level: u32,
+    /// max and mean of `|q_area − q_gnomonic|` over random directions, for values in [0, 1].
+    max_diff: f64,
+    mean_diff: f64,
+    /// The largest jump of an area weight across an edge (f64 areas, both triangles).
+    max_jump: f64,
+}
+
+struct FitRow {
+    level: u32,
+    samples: usize,
+    build_ms: f64,
+    fit_ms: f64,
+    factor_nonzeros: usize,
+    /// `V²/2`: the factor's non-zeros if it filled in completely.
+    dense_nonzeros: usize,
+}
+
+fn directions(n: usize, rng: &mut Rng) -> Vec<Vec3> {
+    (0..n)
+        .map(|_| {
+            let p = rng.sphere();
+            Vec3::new(p[0] as f32, p[1] as f32, p[2] as f32)
+        })
+        .collect()
+}
+
+fn query_rows(opts: &Options, rng: &mut Rng) -> Vec<QueryRow> {
+    let n = opts.scaled(8192).max(256);
+    let dirs = directions(n, rng);
+    let (x, y, z): (Vec<f32>, Vec<f32>, Vec<f32>) = (
+        dirs.iter().map(|d| d.x).collect(),
+        dirs.iter().map(|d| d.y).collect(),
+        dirs.iter().map(|d| d.z).collect(),
+    );
+    (0..=MAX_LEVEL)
+        .map(|level| {
+            let mesh = Icosphere::new(level).expect("level in range");
+            let values: Vec<f32> = (0..mesh.vertices().len())
+                .map(|_| rng.unit() as f32)
+                .collect();
+            let brute = BruteForce::new(&mesh);
+            // The scan costs 20·4^L plane tests per query: fewer queries for it.
+            let brute_n = (n >> (2 * level)).clamp(16, n);
+            let mut out = vec![0.0f32; n];
+            let t = median_times_in_turns(opts.repeats.min(5), 5, |k| match k {
+                0 | 1 => {
+                    let w = if k == 0 {
+                        Weights::Area
+                    } else {
+                        Weights::Gnomonic
+                    };
+                    for (o, d) in out.iter_mut().zip(&dirs) {
+                        *o = mesh.query(&values, black_box(*d), w).unwrap_or(f32::NAN);
+                    }
+                    black_box(&out);
+                }
+                2 | 3 => {
+                    let w = if k == 2 {
+                        Weights::Area
+                    } else {
+                        Weights::Gnomonic
+                    };
+                    steradian_simd::cp::query_slices(&mesh, &values, w, &x, &y, &z, &mut out)
+                        .expect("shapes");
+                    black_box(&out);
+                }
+                _ => {
+                    for (o, d) in out.iter_mut().zip(&dirs[..brute_n]) {
+                        *o = brute.query(&values, black_box(*d));
+                    }
+                    black_box(&out);
+                }
+            });
+            QueryRow {
+                level,
+                scalar_area: ns_per(n, t[0]),
+                scalar_gnomonic: ns_per(n, t[1]),
+                simd_area: ns_per(n, t[2]),
+                simd_gnomonic: ns_per(n, t[3]),
+                brute_force: ns_per(brute_n, t[4]),
+            }
+        })
+        .collect()
+}
+
+fn f64v(v: Vec3) -> [f64; 3] {
+    [f64::from(v.x), f64::from(v.y), f64::from(v.z)]
+}
+
+fn weight_rows(rng: &mut Rng) -> Vec<WeightRow> {
+    let dirs = directions(20_000, rng);
+    (0..=MAX_LEVEL)
+        .map(|level| {
+            let mesh = Icosphere::new(level).expect("level in range");
+            let values: Vec<f32> = (0..mesh.vertices().len())
+                .map(|_| rng.unit() as f32)
+                .collect();
+            let (mut max_diff, mut sum) = (0.0f64, 0.0f64);
+            for d in &dirs {
+                let a = mesh.query(&values, *d, Weights::Area).unwrap_or(f32::NAN);
+                let g = mesh
+                    .query(&values, *d, Weights::Gnomonic)
+                    .unwrap_or(f32::NAN);
+                let e = f64::from((a - g).abs());
+                max_diff = max_diff.max(e);
+                sum += e;
+            }
+            // The jump: a point on the edge (a, b) shared by triangles (a, b, c) and
+            // (b, a, c'), weighted in each with f64 areas; the weight of a differs.
+            let v = mesh.vertices();
+            let mut max_jump = 0.0f64;
+            for (t, tri) in mesh.triangles().iter().enumerate().step_by(7) {
+                let across = mesh.triangle_neighbours()[t][2];
+                let other = mesh.triangles()[across as usize];
+                let (a, b, c) = (
+                    f64v(v[tri[0] as usize]),
+                    f64v(v[tri[1] as usize]),
+                    f64v(v[tri[2] as usize]),
+                );
+                let Some(&c2) = other.iter().find(|k| **k != tri[0] && **k != tri[1]) else {
+                    continue;
+                };
+                let c2 = f64v(v[c2 as usize]);
+                for s in [0.2, 0.5, 0.7] {
+                    let p: [f64; 3] = std::array::from_fn(|k| a[k] * (1.0 - s) + b[k] * s);
+                    let l = (p[0] * p[0] + p[1] * p[1] + p[2] * p[2]).sqrt();
+                    let p = p.map(|x| x / l);
+                    let wa = |c: [f64; 3]| {
+                        let (aa, ab, ac) = (
+                            reference::triangle_area(p, b, c),
+                            reference::triangle_area(a, p, c),
+                            reference::triangle_area(a, b, p),
+                        );
+                        aa / (aa + ab + ac)
+                    };
+                    max_jump = max_jump.max((wa(c) - wa(c2)).abs());
+                }
+            }
+            WeightRow {
+                level,
+                max_diff,
+                mean_diff: sum / dirs.len() as f64,
+                max_jump,
+            }
+        })
+        .collect()
+}
+
+fn fit_rows(opts: &Options, rng: &mut Rng) -> Vec<FitRow> {
+    let mut rows = Vec::new();
+    for &level in &FIT_LEVELS {
+        let mesh = Icosphere::new(level).expect("level in range");
+        let nv = mesh.vertices().len();
+        for &samples in &FIT_SAMPLES {
+            let samples = opts.scaled(samples).clamp(100, samples);
+            let dirs = directions(samples, rng);
+            let values: Vec<f64> = dirs
+                .iter()
+                .map(|d| f64::from((3.0 * d.x).sin() * d.z + d.y))
+                .collect();
+            let (ls, build) = timed(|| LeastSquares::new(&mesh, &dirs));
+            let Ok(ls) = ls else { continue };
+            let t = median_times_in_turns(opts.repeats.min(3), 1, |_| {
+                black_box(ls.fit(&values).ok());
+            });
+            rows.push(FitRow {
+                level,
+                samples,
+                build_ms: build.as_secs_f64() * 1e3,
+                fit_ms: t[0].as_secs_f64() * 1e3,
+                factor_nonzeros: ls.factor_nonzeros(),
+                dense_nonzeros: nv * (nv + 1) / 2,
+            });
+        }
+    }
+    rows
+}
+
+/// The section.
+pub fn section(opts: &Options) -> Result<Section, Box<dyn Error>> {
+    let mut rng = Rng::new(SEED);
+    let query = query_rows(opts, &mut rng);
+    let weights = weight_rows(&mut rng);
+    let fit = fit_rows(opts, &mut rng);
+
+    let mut summary = String::new();
+    let l3 = query.iter().find(|r| r.level == 3);
+    if let Some(r) = l3 {
+        writeln!(
+            summary,
+            "level 3: O(1) location + area weights {:.0} ns/query, {:.0}× the brute-force scan \
+             ({:.0} ns); SIMD {:.2}× scalar (area), {:.2}× (gnomonic)",
+            r.scalar_area,
+            r.brute_force / r.scalar_area,
+            r.brute_force,
+            r.scalar_area / r.simd_area,
+            r.scalar_gnomonic / r.simd_gnomonic
+        )?;
+    }
+    if let (Some(a), Some(b)) = (query.first(), query.last()) {
+        writeln!(
+            summary,
+            "scalar query at level {} / level {}: {:.2}× (the cost does not grow with the level)",
+            b.level,
+            a.level,
+            b.scalar_area / a.scalar_area
+        )?;
+    }
+    if let Some(w) = weights.last() {
+        writeln!(
+            summary,
+            "level {}: |area − gnomonic| ≤ {:.1e} (mean {:.1e}) for values in [0, 1]; area weights jump by up to {:.1e} across an edge",
+            w.level, w.max_diff, w.mean_diff, w.max_jump
+        )?;
+    }
+    if let Some(f) = fit.iter().max_by_key(|f| (f.level, f.samples)) {
+        writeln!(
+            summary,
+            "least-squares fit, level {} from {} samples: {:.1} ms to locate and factor, {:.2} ms per fit; factor {} non-zeros ({:.1} % of dense)",
+            f.level,
+            f.samples,
+            f.build_ms,
+            f.fit_ms,
+            f.factor_nonzeros,
+            100.0 * f.factor_nonzeros as f64 / f.dense_nonzeros as f64
+        )?;
+    }
+
+    let mut html = String::new();
+    writeln!(
+        html,
+        "<p>ns per query (one function, many directions), median of runs taken in turns. The \
+         brute force scans every triangle's three edge planes (precomputed) and takes the one \
+         whose nearest plane is farthest.</p><table><tr><th>level</th><th>triangles</th>\
+         <th>scalar area</th><th>scalar gnomonic</th><th>SIMD area</th><th>SIMD gnomonic</th>\
+         <th>brute force</th><th>SIMD ×scalar (area)</th><th>O(1) ×brute force</th></tr>"
+    )?;
+    for r in &query {
+        writeln!(
+            html,
+            "<tr><td>{}</td><td>{}</td><td>{:.1}</td><td>{:.1}</td><td>{:.1}</td><td>{:.1}</td>\
+             <td>{:.0}</td><td>{:.2}</td><td>{:.0}</td></tr>",
+            r.level,
+            20usize << (2 * r.level),
+            r.scalar_area,
+            r.scalar_gnomonic,
+            r.simd_area,
+            r.simd_gnomonic,
+            r.brute_force,
+            r.scalar_area / r.simd_area,
+            r.brute_force / r.scalar_area
+        )?;
+    }
+    writeln!(
+        html,
+        "</table><p>Area (eq. 2–4) against gnomonic weights on 20 000 random directions, \
+         values uniform in [0, 1]; the area weights' jump across edges (f64 areas of both \
+         triangles at points on a shared edge).</p><table><tr><th>level</th>\
+         <th>max |area − gnomonic|</th><th>mean</th><th>max jump across an edge</th></tr>"
+    )?;
+    for w in &weights {
+        writeln!(
+            html,
+            "<tr><td>{}</td><td>{:.2e}</td><td>{:.2e}</td><td>{:.2e}</td></tr>",
+            w.level, w.max_diff, w.mean_diff, w.max_jump
+        )?;
+    }
+    writeln!(
+        html,
+        "</table><p>Least-squares fit (eq. 3): locate the samples and factor the normal \
+         equations once, then one fit per set of values.</p><table><tr><th>level</th>\
+         <th>samples</th><th>locate + factor (ms)</th><th>fit (ms)</th>\
+         <th>factor non-zeros</th><th>of dense</th></tr>"
+    )?;
+    for f in &fit {
+        writeln!(
+            html,
+            "<tr><td>{}</td><td>{}</td><td>{:.2}</td><td>{:.3}</td><td>{}</td><td>{:.1} %</td></tr>",
+            f.level,
+            f.samples,
+            f.build_ms,
+            f.fit_ms,
+            f.factor_nonzeros,
+            100.0 * f.factor_nonzeros as f64 / f.dense_nonzeros as f64
+        )?;
+    }
+    html.push_str("</table>");
+
+    let data = json!({
+        "query": query.iter().map(|r| json!({
+            "level": r.level,
+            "ns_per_query": {
+                "scalar_area": r.scalar_area,
+                "scalar_gnomonic": r.scalar_gnomonic,
+                "simd_area": r.simd_area,
+                "simd_gnomonic": r.simd_gnomonic,
+                "brute_force": r.brute_force,
+            },
+        })).collect::<Vec<_>>(),
+        "weights": weights.iter().map(|w| json!({
+            "level": w.level,
+            "max_area_minus_gnomonic": w.max_diff,
+            "mean_area_minus_gnomonic": w.mean_diff,
+            "max_area_jump": w.max_jump,
+        })).collect::<Vec<_>>(),
+        "fit": fit.iter().map(|f| json!({
+            "level": f.level,
+            "samples": f.samples,
+            "build_ms": f.build_ms,
+            "fit_ms": f.fit_ms,
+            "factor_nonzeros": f.factor_nonzeros,
+        })).collect::<Vec<_>>(),
+    });
+    Ok(Section {
+        id: "control-points",
+        title: "Control-point spherical functions".into(),
+        summary,
+        html,
+        data,
+        files: Vec::new(),
+    })
+}
