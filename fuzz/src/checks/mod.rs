@@ -3,6 +3,7 @@
 //! `cargo test --workspace`) runs them on every input of the committed corpora
 //! (`fuzz/corpus/<target>/`).
 
+pub mod cp;
 pub mod eval_lines;
 pub mod lobe_product;
 pub mod map_roundtrip;
@@ -17,7 +18,8 @@ pub mod vdt;
 pub type Check = fn(&[u8]);
 
 /// Every target, by name (the corpus folder).
-pub const TARGETS: [(&str, Check); 9] = [
+pub const TARGETS: [(&str, Check); 10] = [
+    ("cp", cp::check),
     ("eval_lines", eval_lines::check),
     ("lobe_product", lobe_product::check),
     ("map_roundtrip", map_roundtrip::check),

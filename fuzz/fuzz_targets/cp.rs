@@ -1,0 +1,7 @@
+//! Fuzz target `cp`: the checks of `steradian_fuzz::checks::cp` (replayed from the
+//! committed corpus by the harness test `fuzz_replay`).
+#![no_main]
+
+use libfuzzer_sys::fuzz_target;
+
+fuzz_target!(|data: &[u8]| steradian_fuzz::checks::cp::check(data));
