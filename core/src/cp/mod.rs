@@ -12,11 +12,14 @@
 //!   the values (the interpolation is linear in them).
 //! - [`fit::Design`] (`fit.rs`): the least-squares fit of eq. 3, as a design matrix and
 //!   its normal equations (factored by the harness).
+//! - [`rotate::Operator`] (`rotate.rs`): rotation by permutation (section 3.4.1), by the
+//!   continuous re-weighting (section 3.4.2), or by resampling, as sparse operators.
 //!
 //! Requires the `alloc` feature (the mesh is built at run time, deterministically).
 
 pub mod fit;
 mod mesh;
+pub mod rotate;
 
 pub use fit::Design;
 pub use mesh::{Icosphere, Location, MAX_LEVEL, OCTANT_EDGES, WEIGHT_ABS_ERROR, Weights};

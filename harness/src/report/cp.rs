@@ -216,12 +216,286 @@ fn fit_rows(opts: &Options, rng: &mut Rng) -> Vec<FitRow> {
     rows
 }
 
+// ---- Representation and rotation, against SH ------------------------------------------
+
+/// Control-point levels of the comparison (42, 162, 642 points).
+pub const COMPARE_LEVELS: [u32; 3] = [1, 2, 3];
+/// SH band counts of the comparison (16, 64, 169, 256 coefficients).
+pub const COMPARE_BANDS: [usize; 4] = [4, 8, 13, 16];
+/// Successive rotations after which the rotation error is measured.
+pub const ROTATION_STEPS: [usize; 3] = [1, 10, 100];
+/// Rotation angles (radians) of the rotation table: below half an edge of the 162-point
+/// mesh (0.28 rad), where the permutation can only be the identity, and above it.
+pub const ROTATION_ANGLES: [f64; 2] = [0.1, 0.5];
+/// The rotation axis: far from the test lobes' axis, so that rotating moves them.
+pub const ROTATION_AXIS: Vec3 = Vec3::new(1.0, -1.0, 0.2);
+
+/// A test function of a direction (unit length).
+pub type TestFunction = fn(Vec3) -> f64;
+
+/// The test functions: Phong lobes of three exponents, a diffuse + specular radiance
+/// distribution, and a stretched sphere (the paper's Figure 4 shape is not given in numbers;
+/// ours is a unit sphere with two smooth bumps).
+pub fn test_functions() -> Vec<(&'static str, TestFunction)> {
+    fn lobe(d: Vec3, e: f64) -> f64 {
+        let a = Vec3::new(0.3, 0.5, 0.81).normalize();
+        f64::from(d.dot(a)).max(0.0).powf(e)
+    }
+    vec![
+        ("Phong e = 1", |d| lobe(d, 1.0)),
+        ("Phong e = 10", |d| lobe(d, 10.0)),
+        ("Phong e = 50", |d| lobe(d, 50.0)),
+        ("diffuse 0.2 + specular e = 20", |d| {
+            0.2 + 0.8 * lobe(d, 20.0)
+        }),
+        ("stretched sphere", |d| {
+            let b = Vec3::new(-0.6, 0.2, -0.77).normalize();
+            1.0 + 0.5 * lobe(d, 8.0) + 0.3 * f64::from(d.dot(b)).max(0.0).powi(4)
+        }),
+    ]
+}
+
+/// Relative L2 error `‖rep − F‖ / ‖F‖` over `dirs`.
+fn rel_l2(dirs: &[Vec3], mut rep: impl FnMut(Vec3) -> f64, f: impl Fn(Vec3) -> f64) -> f64 {
+    let (mut e, mut n) = (0.0, 0.0);
+    for d in dirs {
+        let (r, t) = (rep(*d), f(*d));
+        e += (r - t) * (r - t);
+        n += t * t;
+    }
+    (e / n.max(1e-300)).sqrt()
+}
+
+/// The least-squares SH fit of `f` with `bands` bands from samples at `dirs` (dense normal
+/// equations, nalgebra's Cholesky).
+fn sh_fit(bands: usize, dirs: &[Vec3], f: impl Fn(Vec3) -> f64) -> Vec<f32> {
+    let n = bands * bands;
+    let mut ata = nalgebra::DMatrix::<f64>::zeros(n, n);
+    let mut atb = nalgebra::DVector::<f64>::zeros(n);
+    let mut y = vec![0.0f32; n];
+    for d in dirs {
+        steradian_core::sh::eval_into(*d, bands, &mut y).expect("bands");
+        let fv = f(*d);
+        for a in 0..n {
+            let ya = f64::from(y[a]);
+            atb[a] += ya * fv;
+            for b in 0..=a {
+                ata[(a, b)] += ya * f64::from(y[b]);
+            }
+        }
+    }
+    for a in 0..n {
+        for b in 0..a {
+            ata[(b, a)] = ata[(a, b)];
+        }
+    }
+    match ata.cholesky() {
+        Some(c) => c.solve(&atb).iter().map(|v| *v as f32).collect(),
+        None => vec![0.0; n],
+    }
+}
+
+fn sh_value(c: &[f32], bands: usize, d: Vec3, y: &mut [f32]) -> f64 {
+    steradian_core::sh::eval_into(d, bands, y).expect("bands");
+    c.iter().zip(y.iter()).map(|(a, b)| f64::from(a * b)).sum()
+}
+
+struct Representation {
+    function: &'static str,
+    /// (points, rel. L2) per control-point level.
+    cp: Vec<(usize, f64)>,
+    /// (coefficients, rel. L2) per band count.
+    sh: Vec<(usize, f64)>,
+}
+
+struct RotationRow {
+    angle: f64,
+    function: &'static str,
+    method: &'static str,
+    size: usize,
+    /// Error before rotating, then after each of `ROTATION_STEPS`.
+    errors: Vec<f64>,
+    apply_ns: f64,
+    /// Largest angle between a rotated point and its match (permutation only).
+    worst_match: Option<f64>,
+}
+
+fn representation_rows(rng: &mut Rng) -> Vec<Representation> {
+    let fit_dirs = directions(20_000, rng);
+    let sh_dirs = directions(4_096, rng);
+    let test_dirs = directions(20_000, rng);
+    let meshes: Vec<(Icosphere, LeastSquares)> = COMPARE_LEVELS
+        .iter()
+        .map(|l| {
+            let m = Icosphere::new(*l).expect("level");
+            let ls = LeastSquares::new(&m, &fit_dirs).expect("unit directions");
+            (m, ls)
+        })
+        .collect();
+    test_functions()
+        .into_iter()
+        .map(|(name, f)| {
+            let samples: Vec<f64> = fit_dirs.iter().map(|d| f(*d)).collect();
+            let cp = meshes
+                .iter()
+                .map(|(m, ls)| {
+                    let v: Vec<f32> = ls
+                        .fit(&samples)
+                        .unwrap_or_default()
+                        .iter()
+                        .map(|x| *x as f32)
+                        .collect();
+                    let e = rel_l2(
+                        &test_dirs,
+                        |d| f64::from(m.query(&v, d, Weights::Area).unwrap_or(f32::NAN)),
+                        f,
+                    );
+                    (m.vertices().len(), e)
+                })
+                .collect();
+            let sh = COMPARE_BANDS
+                .iter()
+                .map(|&b| {
+                    let c = sh_fit(b, &sh_dirs, f);
+                    let mut y = vec![0.0f32; b * b];
+                    (b * b, rel_l2(&test_dirs, |d| sh_value(&c, b, d, &mut y), f))
+                })
+                .collect();
+            Representation {
+                function: name,
+                cp,
+                sh,
+            }
+        })
+        .collect()
+}
+
+fn rotation_rows(opts: &Options, rng: &mut Rng) -> Vec<RotationRow> {
+    use steradian_core::cp::rotate::Operator;
+    use steradian_core::sh::rotate::{Operator as ShOperator, Rotation};
+    let fit_dirs = directions(20_000, rng);
+    let sh_dirs = directions(4_096, rng);
+    let test_dirs = directions(4_000, rng);
+    let funcs = test_functions();
+    let picked = [&funcs[1], &funcs[4]];
+    let mut rows = Vec::new();
+    let level = 2;
+    let mesh = Icosphere::new(level).expect("level");
+    let ls = LeastSquares::new(&mesh, &fit_dirs).expect("unit directions");
+    for angle in ROTATION_ANGLES {
+        let rot = Rotation::from_axis_angle(ROTATION_AXIS, angle as f32).expect("rotation");
+        let m = rot.matrix();
+        // R^{-n} applied to a direction: the exact rotated function is f(R^{-n} d).
+        let back = |d: Vec3, n: usize| -> Vec3 {
+            let mut p = d.as_dvec3();
+            for _ in 0..n {
+                p = m.transpose() * p;
+            }
+            p.as_vec3()
+        };
+        let (perm, worst) = Operator::permutation(&mesh, &rot).expect("rotation");
+        let ops = [
+            ("permutation (3.4.1)", perm, Some(f64::from(worst))),
+            (
+                "continuous (3.4.2)",
+                Operator::continuous(&mesh, &rot).expect("rotation"),
+                None,
+            ),
+            (
+                "resampling",
+                Operator::resample(&mesh, &rot).expect("rotation"),
+                None,
+            ),
+        ];
+        let bands = 8;
+        let sh_op = ShOperator::new(&rot, bands).expect("bands");
+        for (name, f) in picked {
+            let samples: Vec<f64> = fit_dirs.iter().map(|d| f(*d)).collect();
+            let v0: Vec<f32> = ls
+                .fit(&samples)
+                .unwrap_or_default()
+                .iter()
+                .map(|x| *x as f32)
+                .collect();
+            for (method, op, worst) in &ops {
+                let mut errors = Vec::new();
+                let mut v = v0.clone();
+                let mut tmp = vec![0.0f32; v.len()];
+                let mut done = 0;
+                for &steps in std::iter::once(&0).chain(ROTATION_STEPS.iter()) {
+                    while done < steps {
+                        op.apply(&v, &mut tmp).expect("lengths");
+                        std::mem::swap(&mut v, &mut tmp);
+                        done += 1;
+                    }
+                    errors.push(rel_l2(
+                        &test_dirs,
+                        |d| f64::from(mesh.query(&v, d, Weights::Area).unwrap_or(f32::NAN)),
+                        |d| f(back(d, steps)),
+                    ));
+                }
+                let t = median_times_in_turns(opts.repeats.min(5), 1, |_| {
+                    for _ in 0..100 {
+                        op.apply(black_box(&v0), &mut tmp).expect("lengths");
+                    }
+                    black_box(&tmp);
+                });
+                rows.push(RotationRow {
+                    angle,
+                    function: name,
+                    method,
+                    size: v0.len(),
+                    errors,
+                    apply_ns: ns_per(100, t[0]),
+                    worst_match: *worst,
+                });
+            }
+            let c0 = sh_fit(bands, &sh_dirs, f);
+            let mut c = c0.clone();
+            let mut tmp = vec![0.0f32; c.len()];
+            let mut y = vec![0.0f32; c.len()];
+            let mut errors = Vec::new();
+            let mut done = 0;
+            for &steps in std::iter::once(&0).chain(ROTATION_STEPS.iter()) {
+                while done < steps {
+                    sh_op.apply(&c, &mut tmp).expect("lengths");
+                    std::mem::swap(&mut c, &mut tmp);
+                    done += 1;
+                }
+                errors.push(rel_l2(
+                    &test_dirs,
+                    |d| sh_value(&c, bands, d, &mut y),
+                    |d| f(back(d, steps)),
+                ));
+            }
+            let t = median_times_in_turns(opts.repeats.min(5), 1, |_| {
+                for _ in 0..100 {
+                    sh_op.apply(black_box(&c0), &mut tmp).expect("lengths");
+                }
+                black_box(&tmp);
+            });
+            rows.push(RotationRow {
+                angle,
+                function: name,
+                method: "SH operator (Ivanic–Ruedenberg)",
+                size: c0.len(),
+                errors,
+                apply_ns: ns_per(100, t[0]),
+                worst_match: None,
+            });
+        }
+    }
+    rows
+}
+
 /// The section.
 pub fn section(opts: &Options) -> Result<Section, Box<dyn Error>> {
     let mut rng = Rng::new(SEED);
     let query = query_rows(opts, &mut rng);
     let weights = weight_rows(&mut rng);
     let fit = fit_rows(opts, &mut rng);
+    let repr = representation_rows(&mut rng);
+    let rotation = rotation_rows(opts, &mut rng);
 
     let mut summary = String::new();
     let l3 = query.iter().find(|r| r.level == 3);
@@ -325,6 +599,86 @@ pub fn section(opts: &Options) -> Result<Section, Box<dyn Error>> {
         )?;
     }
     html.push_str("</table>");
+    writeln!(
+        html,
+        "<p>Representation error (relative L2 over 20 000 random directions) of least-squares \
+         fits: control points (area weights, fitted from 20 000 samples) against SH (fitted \
+         from 4096 samples).</p><table><tr><th>function</th>{}{}</tr>",
+        COMPARE_LEVELS
+            .iter()
+            .map(|l| format!("<th>{} CP</th>", 10 * (1usize << (2 * l)) + 2))
+            .collect::<String>(),
+        COMPARE_BANDS
+            .iter()
+            .map(|b| format!("<th>{} SH</th>", b * b))
+            .collect::<String>()
+    )?;
+    for r in &repr {
+        writeln!(
+            html,
+            "<tr><td>{}</td>{}{}</tr>",
+            r.function,
+            r.cp.iter()
+                .map(|(_, e)| format!("<td>{e:.2e}</td>"))
+                .collect::<String>(),
+            r.sh.iter()
+                .map(|(_, e)| format!("<td>{e:.2e}</td>"))
+                .collect::<String>()
+        )?;
+    }
+    writeln!(
+        html,
+        "</table><p>Rotation by 0.1 rad about (1, 2, 3), applied 1, 10 and 100 times: \
+         relative L2 error against the function rotated exactly (first column: before \
+         rotating, the representation error). 162 control points, 64 SH coefficients.</p>\
+         <table><tr><th>angle</th><th>function</th><th>method</th><th>size</th><th>0</th><th>1</th>\
+         <th>10</th><th>100</th><th>ns per rotation</th><th>worst match (rad)</th></tr>"
+    )?;
+    for r in &rotation {
+        writeln!(
+            html,
+            "<tr><td>{}</td><td>{}</td><td>{}</td><td>{}</td>{}<td>{:.0}</td><td>{}</td></tr>",
+            r.angle,
+            r.function,
+            r.method,
+            r.size,
+            r.errors
+                .iter()
+                .map(|e| format!("<td>{e:.2e}</td>"))
+                .collect::<String>(),
+            r.apply_ns,
+            r.worst_match.map_or("".into(), |w| format!("{w:.3}"))
+        )?;
+    }
+    html.push_str("</table>");
+    for r in rotation.iter().filter(|r| r.function == "stretched sphere") {
+        writeln!(
+            summary,
+            "stretched sphere rotated by {} rad 0/1/10/100 times, {} ({}): rel. L2 {}",
+            r.angle,
+            r.method,
+            r.size,
+            r.errors
+                .iter()
+                .map(|e| format!("{e:.1e}"))
+                .collect::<Vec<_>>()
+                .join(" → ")
+        )?;
+    }
+    if let Some(r) = repr.iter().find(|r| r.function == "stretched sphere") {
+        writeln!(
+            summary,
+            "stretched sphere, rel. L2: {} | {}",
+            r.cp.iter()
+                .map(|(n, e)| format!("{n} CP {e:.1e}"))
+                .collect::<Vec<_>>()
+                .join(", "),
+            r.sh.iter()
+                .map(|(n, e)| format!("{n} SH {e:.1e}"))
+                .collect::<Vec<_>>()
+                .join(", ")
+        )?;
+    }
 
     let data = json!({
         "query": query.iter().map(|r| json!({
@@ -342,6 +696,21 @@ pub fn section(opts: &Options) -> Result<Section, Box<dyn Error>> {
             "max_area_minus_gnomonic": w.max_diff,
             "mean_area_minus_gnomonic": w.mean_diff,
             "max_area_jump": w.max_jump,
+        })).collect::<Vec<_>>(),
+        "representation": repr.iter().map(|r| json!({
+            "function": r.function,
+            "cp": r.cp.iter().map(|(n, e)| json!({"points": n, "rel_l2": e})).collect::<Vec<_>>(),
+            "sh": r.sh.iter().map(|(n, e)| json!({"coefficients": n, "rel_l2": e})).collect::<Vec<_>>(),
+        })).collect::<Vec<_>>(),
+        "rotation": rotation.iter().map(|r| json!({
+            "angle": r.angle,
+            "function": r.function,
+            "method": r.method,
+            "size": r.size,
+            "steps": [0, 1, 10, 100],
+            "rel_l2": r.errors,
+            "apply_ns": r.apply_ns,
+            "worst_match_rad": r.worst_match,
         })).collect::<Vec<_>>(),
         "fit": fit.iter().map(|f| json!({
             "level": f.level,
