@@ -442,7 +442,11 @@ pub const KERNELS: &[KernelSpec] = &[
         eval: Piece::At(handlers::cp_query),
         scalar: "steradian_core::cp::mesh::Icosphere::query",
         simd: Piece::At("steradian_simd::cp::query_slices"),
-        wgsl: Piece::Without("not written yet"),
+        wgsl: Piece::At(WgslTwin {
+            source: wgsl::CP_QUERY,
+            tolerance: "steradian_core::wgsl::CP_QUERY_TOL",
+            table: Some("f32"),
+        }),
         reference: Piece::At("steradian_reference::cp::locate"),
         bound: Piece::At(Bound {
             metric: "abs weight error",

@@ -6,6 +6,7 @@ mod brdf;
 mod common;
 mod coverage;
 mod cp;
+mod cp_gpu;
 mod cycles;
 mod env;
 mod fuzz_replay;

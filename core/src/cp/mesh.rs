@@ -431,6 +431,32 @@ impl Icosphere {
         self.octant[o & 7][r & 3] as usize
     }
 
+    /// The table of the WGSL twin (`wgsl::CP_QUERY`, binding 3): `[level, weights (0 area,
+    /// 1 gnomonic), V]`, [`OCTANT_EDGES`] (9), the face planes (20 × 9), the octant table
+    /// (8 × 4), the grid (20 × (2^L + 1)², −1 outside each face's triangle), the vertices (3V)
+    /// and `values` (V); integers as `f32` (all below 2²⁴, exact). Errors: a wrong number of values.
+    pub fn gpu_table(&self, values: &[f32], weights: Weights) -> Result<Vec<f32>, Error> {
+        self.check(values)?;
+        let nv = self.vertices.len();
+        let mut t = Vec::with_capacity(224 + self.grid.len() + 4 * nv);
+        t.extend([
+            self.level as f32,
+            (weights == Weights::Gnomonic) as u32 as f32,
+            nv as f32,
+        ]);
+        t.extend(OCTANT_EDGES.iter().flat_map(|e| [e.x, e.y, e.z]));
+        t.extend(self.cross.iter().flatten().flat_map(|e| [e.x, e.y, e.z]));
+        t.extend(self.octant.iter().flatten().map(|f| f32::from(*f)));
+        t.extend(
+            self.grid
+                .iter()
+                .map(|g| if *g == u32::MAX { -1.0 } else { *g as f32 }),
+        );
+        t.extend(self.vertices.iter().flat_map(|v| [v.x, v.y, v.z]));
+        t.extend_from_slice(values);
+        Ok(t)
+    }
+
     /// The vertex at grid point `(i, j)` (`i + j ≤ 2^L`) of base face `f`, or `u32::MAX`
     /// outside the grid.
     pub fn grid_vertex(&self, f: usize, i: usize, j: usize) -> u32 {

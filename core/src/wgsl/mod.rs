@@ -170,6 +170,24 @@ pub const VDT_QUERY: &str = concat!(
 /// by the half-side). Lavapipe: bit-identical (harness test `tests/vdt_gpu.rs`).
 pub const VDT_QUERY_TOL: f32 = 2.0e-6;
 
+/// Control-point query (`cp::Icosphere::query`): input columns `[x, y, z]` (any non-zero
+/// length), output `[value]`, NaN for a zero or non-finite direction. Binding 3 is the table
+/// of `cp::Icosphere::gpu_table` (mesh, weight kind and the values). Not in [`ALL`]: run it
+/// with the harness's custom kernels. Same operations as the scalar kernel; WGSL's `atan2`
+/// and division are not the standard library's, and on an edge the kernel may pick the other
+/// triangle, where the area weights differ by their documented discontinuity (≤ 3.3e-4 of
+/// the value difference at level 2, measured by the report): [`CP_QUERY_TOL`] holds off the
+/// edges, and everywhere with gnomonic weights.
+pub const CP_QUERY: &str = concat!(
+    include_str!("batch.wgsl"),
+    include_str!("../cp/cp_query.wgsl")
+);
+/// Difference allowed between [`CP_QUERY`] and `cp::Icosphere::query`, in units of the
+/// largest `|value|` of the triangle's three vertices. Lavapipe: gnomonic weights
+/// bit-identical; area weights `7.0e-6` at level 0 (its `atan2` on the largest triangles),
+/// `2.1e-7` from level 2 (harness test `tests/cp_gpu.rs`, which prints them).
+pub const CP_QUERY_TOL: f32 = 1.0e-5;
+
 /// All `bands²` real SH at a direction (`sh::eval_into`) in `f32`, for `bands ≤ 16`
 /// ([`SH_EVAL_MAX_BANDS`]). Input columns `[x, y, z]`, output columns `l² + l + m`. Binding 3
 /// is one `f32`: the band count. Not in [`ALL`]: run it with the harness's custom kernels.
@@ -300,7 +318,8 @@ pub const ALL: [(&str, &str); 5] = [
 
 /// The kernels outside [`ALL`], with a caller-supplied table at binding 3 (run them with
 /// the harness's custom kernels), as `(name, source, element type of the table)`.
-pub const CUSTOM: [(&str, &str, &str); 6] = [
+pub const CUSTOM: [(&str, &str, &str); 7] = [
+    ("cp-query", CP_QUERY, "f32"),
     ("lobe-product", LOBE_PRODUCT, "f32"),
     ("sh-eval", SH_EVAL, "f32"),
     ("sat-box", SAT_BOX, "u32"),

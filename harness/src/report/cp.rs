@@ -15,9 +15,12 @@ use steradian_reference::cp as reference;
 
 use super::Options;
 use super::section::Section;
-use super::timing::{median_times_in_turns, ns_per, timed};
+use super::timing::{median_time, median_times_in_turns, ns_per, timed};
+use crate::backend::gpu::{self, Custom, Gpu};
 use crate::cp::{BruteForce, LeastSquares};
+use crate::kernels::Columns;
 use crate::rng::Rng;
+use steradian_core::wgsl;
 
 const SEED: u64 = 0x0c90_5eed;
 /// Levels of the fit table and its sample counts.
@@ -33,6 +36,8 @@ struct QueryRow {
     simd_area: f64,
     simd_gnomonic: f64,
     brute_force: f64,
+    /// wgpu (area weights), upload and read-back included; `None` without an adapter.
+    wgpu: Option<f64>,
 }
 
 /// One level of the weight comparison.
@@ -64,7 +69,7 @@ fn directions(n: usize, rng: &mut Rng) -> Vec<Vec3> {
         .collect()
 }
 
-fn query_rows(opts: &Options, rng: &mut Rng) -> Vec<QueryRow> {
+fn query_rows(opts: &Options, rng: &mut Rng, gpu: &mut Option<Gpu>) -> Vec<QueryRow> {
     let n = opts.scaled(8192).max(256);
     let dirs = directions(n, rng);
     let (x, y, z): (Vec<f32>, Vec<f32>, Vec<f32>) = (
@@ -72,12 +77,28 @@ fn query_rows(opts: &Options, rng: &mut Rng) -> Vec<QueryRow> {
         dirs.iter().map(|d| d.y).collect(),
         dirs.iter().map(|d| d.z).collect(),
     );
+    let rows: Vec<[f32; 3]> = dirs.iter().map(|d| d.to_array()).collect();
+    let columns = Columns::from_rows(&rows);
     (0..=MAX_LEVEL)
         .map(|level| {
             let mesh = Icosphere::new(level).expect("level in range");
             let values: Vec<f32> = (0..mesh.vertices().len())
                 .map(|_| rng.unit() as f32)
                 .collect();
+            let wgpu = gpu.as_mut().and_then(|g| {
+                let table = mesh.gpu_table(&values, Weights::Area).ok()?;
+                let custom = Custom {
+                    label: "cp-query",
+                    source: wgsl::CP_QUERY,
+                    table: Some(&table),
+                };
+                let mut out = Columns::zeros(1, n);
+                let t = median_time(opts.repeats.min(5), || {
+                    g.run_custom(&custom, &columns, &mut out)
+                        .expect("cp kernel runs");
+                });
+                Some(ns_per(n, t))
+            });
             let brute = BruteForce::new(&mesh);
             // The scan costs 20·4^L plane tests per query: fewer queries for it.
             let brute_n = (n >> (2 * level)).clamp(16, n);
@@ -118,6 +139,7 @@ fn query_rows(opts: &Options, rng: &mut Rng) -> Vec<QueryRow> {
                 simd_area: ns_per(n, t[2]),
                 simd_gnomonic: ns_per(n, t[3]),
                 brute_force: ns_per(brute_n, t[4]),
+                wgpu,
             }
         })
         .collect()
@@ -491,7 +513,8 @@ fn rotation_rows(opts: &Options, rng: &mut Rng) -> Vec<RotationRow> {
 /// The section.
 pub fn section(opts: &Options) -> Result<Section, Box<dyn Error>> {
     let mut rng = Rng::new(SEED);
-    let query = query_rows(opts, &mut rng);
+    let (mut gpu, gpu_note) = gpu::if_requested(opts.gpu);
+    let query = query_rows(opts, &mut rng, &mut gpu);
     let weights = weight_rows(&mut rng);
     let fit = fit_rows(opts, &mut rng);
     let repr = representation_rows(&mut rng);
@@ -545,15 +568,17 @@ pub fn section(opts: &Options) -> Result<Section, Box<dyn Error>> {
         html,
         "<p>ns per query (one function, many directions), median of runs taken in turns. The \
          brute force scans every triangle's three edge planes (precomputed) and takes the one \
-         whose nearest plane is farthest.</p><table><tr><th>level</th><th>triangles</th>\
+         whose nearest plane is farthest; wgpu: {gpu_note}, upload and read-back included.\
+         </p><table><tr><th>level</th><th>triangles</th>\
          <th>scalar area</th><th>scalar gnomonic</th><th>SIMD area</th><th>SIMD gnomonic</th>\
-         <th>brute force</th><th>SIMD ×scalar (area)</th><th>O(1) ×brute force</th></tr>"
+         <th>brute force</th><th>wgpu (area)</th><th>SIMD ×scalar (area)</th>\
+         <th>O(1) ×brute force</th></tr>"
     )?;
     for r in &query {
         writeln!(
             html,
             "<tr><td>{}</td><td>{}</td><td>{:.1}</td><td>{:.1}</td><td>{:.1}</td><td>{:.1}</td>\
-             <td>{:.0}</td><td>{:.2}</td><td>{:.0}</td></tr>",
+             <td>{:.0}</td><td>{}</td><td>{:.2}</td><td>{:.0}</td></tr>",
             r.level,
             20usize << (2 * r.level),
             r.scalar_area,
@@ -561,6 +586,7 @@ pub fn section(opts: &Options) -> Result<Section, Box<dyn Error>> {
             r.simd_area,
             r.simd_gnomonic,
             r.brute_force,
+            r.wgpu.map_or("—".to_string(), |g| format!("{g:.1}")),
             r.scalar_area / r.simd_area,
             r.brute_force / r.scalar_area
         )?;
@@ -681,6 +707,7 @@ pub fn section(opts: &Options) -> Result<Section, Box<dyn Error>> {
     }
 
     let data = json!({
+        "gpu": gpu_note,
         "query": query.iter().map(|r| json!({
             "level": r.level,
             "ns_per_query": {
@@ -689,6 +716,7 @@ pub fn section(opts: &Options) -> Result<Section, Box<dyn Error>> {
                 "simd_area": r.simd_area,
                 "simd_gnomonic": r.simd_gnomonic,
                 "brute_force": r.brute_force,
+                "wgpu": r.wgpu,
             },
         })).collect::<Vec<_>>(),
         "weights": weights.iter().map(|w| json!({
