@@ -144,6 +144,97 @@ pub fn fit(mesh: &Icosphere, samples: &[[f32; 4]]) -> Result<Vec<f64>, String> {
     LeastSquares::new(mesh, &dirs)?.fit(&values)
 }
 
+/// The error the L∞ fit minimises over the samples (the paper's eq. 5–7), each sample's
+/// residual divided by its scale `s_i`: 1, `|f_i|` or `√|f_i|`. The relative scales are
+/// floored at `1e-6·max|f|`, so that a zero sample is not an equality constraint.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Linf {
+    /// Eq. 5: `max |A v − f|`.
+    Absolute,
+    /// Eq. 6: `max |A v − f| / |f|`.
+    Relative,
+    /// Eq. 7: `max |A v − f| / √|f|` (the paper's compromise).
+    SqrtRelative,
+}
+
+impl Linf {
+    /// All three, in the paper's order.
+    pub const ALL: [Linf; 3] = [Linf::Absolute, Linf::Relative, Linf::SqrtRelative];
+
+    /// Its name in the report.
+    pub fn name(self) -> &'static str {
+        match self {
+            Linf::Absolute => "L∞ absolute (eq. 5)",
+            Linf::Relative => "L∞ relative (eq. 6)",
+            Linf::SqrtRelative => "L∞ sqrt-relative (eq. 7)",
+        }
+    }
+}
+
+/// The L∞ fit of eq. 5–7 by linear programming (`microlp`): minimise `h` subject to
+/// `−h·s_i ≤ (A v − f)_i ≤ h·s_i` for every sample. Vertices no sample touches are 0.
+/// Returns the values and the optimal `h`. Errors: a wrong number of values, or the
+/// solver's failure (reported, not hidden).
+pub fn fit_linf(design: &Design, values: &[f64], scale: Linf) -> Result<(Vec<f64>, f64), String> {
+    use microlp::{ComparisonOp, OptimizationDirection, Problem};
+    let rows = design.rows();
+    if values.len() != rows.len() {
+        return Err(format!(
+            "{} sample values for {} samples",
+            values.len(),
+            rows.len()
+        ));
+    }
+    let nv = design.vertex_count();
+    let mut touched = vec![false; nv];
+    for r in rows {
+        for (v, w) in r.vertices.iter().zip(r.weights) {
+            if w != 0.0 {
+                touched[*v as usize] = true;
+            }
+        }
+    }
+    let mut p = Problem::new(OptimizationDirection::Minimize);
+    let x: Vec<_> = touched
+        .iter()
+        .map(|t| {
+            let b = if *t { f64::INFINITY } else { 0.0 };
+            p.add_var(0.0, (-b, b))
+        })
+        .collect();
+    let h = p.add_var(1.0, (0.0, f64::INFINITY));
+    let floor = 1e-6 * values.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+    for (r, f) in rows.iter().zip(values) {
+        let s = match scale {
+            Linf::Absolute => 1.0,
+            Linf::Relative => f.abs().max(floor),
+            Linf::SqrtRelative => f.abs().max(floor).sqrt(),
+        };
+        let mut e: Vec<(microlp::Variable, f64)> = r
+            .vertices
+            .iter()
+            .zip(r.weights)
+            .filter(|(_, w)| *w != 0.0)
+            .map(|(v, w)| (x[*v as usize], f64::from(w)))
+            .collect();
+        e.push((h, -s));
+        p.add_constraint(e.as_slice(), ComparisonOp::Le, *f);
+        if let Some(last) = e.last_mut() {
+            last.1 = s;
+        }
+        p.add_constraint(e.as_slice(), ComparisonOp::Ge, *f);
+    }
+    let sol = p
+        .solve()
+        .map_err(|e| format!("linear program: {e}"))?
+        .into_solution()
+        .map_err(|e| format!("linear program interrupted: {e:?}"))?;
+    Ok((
+        x.iter().map(|v| sol.var_value(*v)).collect(),
+        sol.var_value(h),
+    ))
+}
+
 /// The dense `f64` reference: the minimum-norm least-squares solution `A⁺f` by the SVD of
 /// the design matrix (singular values below `1e-12·σ_max` treated as zero). O(S·V²): for
 /// tests and the report at levels ≤ 2.

@@ -315,3 +315,63 @@ fn brute_force_baseline_agrees_with_the_o1_query() {
         }
     }
 }
+
+#[test]
+fn linf_fits_are_optimal_and_exact_where_the_mesh_represents() {
+    use steradian_harness::cp::{Linf, fit_dense_reference, fit_linf};
+    let level = 1;
+    let mesh = steradian_core::cp::Icosphere::new(level).unwrap();
+    let samples: Vec<[f64; 4]> = spiral(600, 1.0)
+        .into_iter()
+        .map(|d| {
+            let l = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
+            [
+                d[0],
+                d[1],
+                d[2],
+                0.1 + (0.6 * d[0] + 0.8 * d[2]).max(0.0).powi(6) / l.powi(6),
+            ]
+        })
+        .collect();
+    let d = design(level, &samples);
+    let values: Vec<f64> = samples.iter().map(|s| s[3]).collect();
+    let ls = fit_dense_reference(&d, &values);
+    let max_err = |v: &[f64], scale: &dyn Fn(f64) -> f64| {
+        d.apply(v)
+            .unwrap()
+            .iter()
+            .zip(&values)
+            .map(|(a, f)| (a - f).abs() / scale(*f))
+            .fold(0.0f64, f64::max)
+    };
+    for kind in Linf::ALL {
+        let (v, h) = fit_linf(&d, &values, kind).unwrap();
+        let scale = |f: f64| match kind {
+            Linf::Absolute => 1.0,
+            Linf::Relative => f.abs(),
+            Linf::SqrtRelative => f.abs().sqrt(),
+        };
+        // The optimum h is the fit's own worst scaled residual, and no larger than the
+        // least-squares fit's (which the linear program could have chosen).
+        let own = max_err(&v, &scale);
+        assert!(
+            (own - h).abs() <= 1e-6 * h.max(1e-12),
+            "{kind:?}: h {h} vs {own}"
+        );
+        assert!(h <= max_err(&ls, &scale) * (1.0 + 1e-9), "{kind:?}");
+    }
+    // Samples of the interpolant itself: every L∞ fit reproduces it (h = 0, the values).
+    let truth: Vec<f32> = (0..mesh.vertices().len())
+        .map(|k| 1.0 + (k % 5) as f32 * 0.25)
+        .collect();
+    let exact: Vec<f64> = d
+        .apply(&truth.iter().map(|t| f64::from(*t)).collect::<Vec<_>>())
+        .unwrap();
+    for kind in Linf::ALL {
+        let (v, h) = fit_linf(&d, &exact, kind).unwrap();
+        assert!(h < 1e-9, "{kind:?}: h = {h}");
+        for (a, b) in v.iter().zip(&truth) {
+            assert!((a - f64::from(*b)).abs() < 1e-6, "{kind:?}: {a} vs {b}");
+        }
+    }
+}

@@ -17,7 +17,7 @@ use super::Options;
 use super::section::Section;
 use super::timing::{median_time, median_times_in_turns, ns_per, timed};
 use crate::backend::gpu::{self, Custom, Gpu};
-use crate::cp::{BruteForce, LeastSquares};
+use crate::cp::{BruteForce, LeastSquares, Linf, fit_linf};
 use crate::kernels::Columns;
 use crate::rng::Rng;
 use steradian_core::wgsl;
@@ -392,6 +392,63 @@ fn representation_rows(rng: &mut Rng) -> Vec<Representation> {
         .collect()
 }
 
+/// A fit's values, or why the solver gave none.
+type FitResult = Result<Vec<f64>, String>;
+
+/// One fit of one test function at 162 points.
+struct FitCompare {
+    function: &'static str,
+    fit: &'static str,
+    rel_l2: f64,
+    max_abs: f64,
+    /// `max |rep − F| / F` over the test directions (the functions are positive).
+    max_rel: f64,
+    ms: f64,
+}
+
+/// Least squares against the three L∞ fits (eq. 5–7) at level 2 from 2000 samples, errors
+/// over 20 000 other directions.
+fn fit_compare_rows(rng: &mut Rng) -> Vec<FitCompare> {
+    let mesh = Icosphere::new(2).expect("level");
+    let dirs = directions(2_000, rng);
+    let test_dirs = directions(20_000, rng);
+    let design = steradian_core::cp::Design::new(&mesh, &dirs).expect("unit directions");
+    let ls = LeastSquares::new(&mesh, &dirs).expect("unit directions");
+    let mut rows = Vec::new();
+    for (name, f) in test_functions() {
+        // Positive versions: the relative fits divide by the value.
+        let g = move |d: Vec3| f(d) + 0.05;
+        let values: Vec<f64> = dirs.iter().map(|d| g(*d)).collect();
+        let mut fits: Vec<(&'static str, FitResult, f64)> = Vec::new();
+        let (v, t) = timed(|| ls.fit(&values));
+        fits.push(("least squares (eq. 3)", v, t.as_secs_f64() * 1e3));
+        for kind in Linf::ALL {
+            let (v, t) = timed(|| fit_linf(&design, &values, kind).map(|r| r.0));
+            fits.push((kind.name(), v, t.as_secs_f64() * 1e3));
+        }
+        for (fit, v, ms) in fits {
+            let Ok(v) = v else { continue };
+            let v: Vec<f32> = v.iter().map(|x| *x as f32).collect();
+            let (mut max_abs, mut max_rel) = (0.0f64, 0.0f64);
+            let q = |d: Vec3| f64::from(mesh.query(&v, d, Weights::Area).unwrap_or(f32::NAN));
+            for d in &test_dirs {
+                let (r, t) = (q(*d), g(*d));
+                max_abs = max_abs.max((r - t).abs());
+                max_rel = max_rel.max((r - t).abs() / t);
+            }
+            rows.push(FitCompare {
+                function: name,
+                fit,
+                rel_l2: rel_l2(&test_dirs, q, g),
+                max_abs,
+                max_rel,
+                ms,
+            });
+        }
+    }
+    rows
+}
+
 fn rotation_rows(opts: &Options, rng: &mut Rng) -> Vec<RotationRow> {
     use steradian_core::cp::rotate::Operator;
     use steradian_core::sh::rotate::{Operator as ShOperator, Rotation};
@@ -518,6 +575,7 @@ pub fn section(opts: &Options) -> Result<Section, Box<dyn Error>> {
     let weights = weight_rows(&mut rng);
     let fit = fit_rows(opts, &mut rng);
     let repr = representation_rows(&mut rng);
+    let compare = fit_compare_rows(&mut rng);
     let rotation = rotation_rows(opts, &mut rng);
 
     let mut summary = String::new();
@@ -654,7 +712,23 @@ pub fn section(opts: &Options) -> Result<Section, Box<dyn Error>> {
     }
     writeln!(
         html,
-        "</table><p>Rotation by 0.1 rad about (1, 2, 3), applied 1, 10 and 100 times: \
+        "</table><p>Fits compared at 162 points from 2000 samples (each function + 0.05, so \
+         that the relative fits are defined), errors over 20 000 other directions.</p>\
+         <table><tr><th>function</th><th>fit</th><th>rel. L2</th><th>max abs</th>\
+         <th>max rel</th><th>ms</th></tr>"
+    )?;
+    for c in &compare {
+        writeln!(
+            html,
+            "<tr><td>{}</td><td>{}</td><td>{:.2e}</td><td>{:.2e}</td><td>{:.2e}</td>\
+             <td>{:.1}</td></tr>",
+            c.function, c.fit, c.rel_l2, c.max_abs, c.max_rel, c.ms
+        )?;
+    }
+    writeln!(
+        html,
+        "</table><p>Rotation by 0.1 and 0.5 rad about (1, −1, 0.2), applied 1, 10 and 100 \
+         times: \
          relative L2 error against the function rotated exactly (first column: before \
          rotating, the representation error). 162 control points, 64 SH coefficients.</p>\
          <table><tr><th>angle</th><th>function</th><th>method</th><th>size</th><th>0</th><th>1</th>\
@@ -729,6 +803,14 @@ pub fn section(opts: &Options) -> Result<Section, Box<dyn Error>> {
             "function": r.function,
             "cp": r.cp.iter().map(|(n, e)| json!({"points": n, "rel_l2": e})).collect::<Vec<_>>(),
             "sh": r.sh.iter().map(|(n, e)| json!({"coefficients": n, "rel_l2": e})).collect::<Vec<_>>(),
+        })).collect::<Vec<_>>(),
+        "fits": compare.iter().map(|c| json!({
+            "function": c.function,
+            "fit": c.fit,
+            "rel_l2": c.rel_l2,
+            "max_abs": c.max_abs,
+            "max_rel": c.max_rel,
+            "ms": c.ms,
         })).collect::<Vec<_>>(),
         "rotation": rotation.iter().map(|r| json!({
             "angle": r.angle,
