@@ -375,3 +375,33 @@ fn linf_fits_are_optimal_and_exact_where_the_mesh_represents() {
         }
     }
 }
+
+#[test]
+fn transport_benchmark_agrees_between_representations() {
+    // The section 3.5 benchmark computes the same irradiance with control points and SH,
+    // up to their representation errors; the lit scene has positive, finite irradiance.
+    use steradian_harness::report::cp_transport::{
+        ControlPoints, Harmonics, Scene, Visibility, run,
+    };
+    let scene = Scene::cubes();
+    let vis = Visibility::new(&scene, 45);
+    assert!(vis.links() > 0);
+    let (_, a) = run(&ControlPoints::new(2), &scene, &vis);
+    let (_, b) = run(&Harmonics::new(8), &scene, &vis);
+    assert_eq!(a.len(), scene.surfaces());
+    assert!(a.iter().chain(&b).all(|e| e.is_finite() && *e >= 0.0));
+    let max = b.iter().fold(0.0f64, |m, v| m.max(*v));
+    assert!(max > 0.0);
+    let lit: Vec<(f64, f64)> = a
+        .iter()
+        .zip(&b)
+        .filter(|(_, y)| **y > 1e-3 * max)
+        .map(|(x, y)| (*x, *y))
+        .collect();
+    let mean = lit.iter().map(|(x, y)| (x - y).abs() / y).sum::<f64>() / lit.len() as f64;
+    assert!(
+        lit.len() > scene.surfaces() / 2 && mean < 0.05,
+        "{} lit, mean rel. diff {mean}",
+        lit.len()
+    );
+}

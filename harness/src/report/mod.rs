@@ -4,6 +4,7 @@
 
 pub mod brdf;
 pub mod cp;
+pub mod cp_transport;
 pub mod lobe_sum;
 pub mod plot;
 pub mod product;
