@@ -612,6 +612,101 @@ fn transport_rows(opts: &Options) -> Vec<TransportRow> {
         .collect()
 }
 
+/// Operation times of the two representations at comparable sizes (162 control points,
+/// 64 SH coefficients): ns per query (locating or evaluating the basis included), per query
+/// when the weights or basis values are shared along a direction, per add and per scale.
+struct OpTimes {
+    cp: [f64; 4],
+    sh: [f64; 4],
+}
+
+fn op_times(opts: &Options, rng: &mut Rng) -> OpTimes {
+    let mesh = Icosphere::new(2).expect("level");
+    let nv = mesh.vertices().len();
+    let bands = 8;
+    let nn = bands * bands;
+    let dirs = directions(opts.scaled(4096).max(256), rng);
+    let f: Vec<f32> = (0..nv).map(|_| rng.unit() as f32).collect();
+    let c: Vec<f32> = (0..nn).map(|_| rng.unit() as f32).collect();
+    let loc = mesh
+        .locate(Vec3::new(0.3, 0.5, 0.8), Weights::Area)
+        .expect("unit");
+    let mut y = vec![0.0f32; nn];
+    steradian_core::sh::eval_into(Vec3::new(0.3, 0.5, 0.8), bands, &mut y).expect("bands");
+    let (mut fa, mut ca) = (f.clone(), c.clone());
+    let reps = 1000;
+    let dot = super::cp_transport::dot;
+    let t = median_times_in_turns(opts.repeats.min(5), 8, |k| match k {
+        0 => {
+            for d in &dirs {
+                black_box(mesh.query(&f, black_box(*d), Weights::Area).ok());
+            }
+        }
+        1 => {
+            let mut yy = vec![0.0f32; nn];
+            for d in &dirs {
+                steradian_core::sh::eval_into(black_box(*d), bands, &mut yy).expect("bands");
+                black_box(dot(&c, &yy));
+            }
+        }
+        2 => {
+            for _ in 0..reps {
+                black_box(black_box(&loc).interpolate(black_box(&f)));
+            }
+        }
+        3 => {
+            for _ in 0..reps {
+                black_box(dot(black_box(&c), black_box(&y)));
+            }
+        }
+        4 => {
+            for _ in 0..reps {
+                for (a, b) in fa.iter_mut().zip(black_box(&f)) {
+                    *a += b;
+                }
+                black_box(&fa);
+            }
+        }
+        5 => {
+            for _ in 0..reps {
+                for (a, b) in ca.iter_mut().zip(black_box(&c)) {
+                    *a += b;
+                }
+                black_box(&ca);
+            }
+        }
+        6 => {
+            for _ in 0..reps {
+                let k = black_box(0.999f32);
+                fa.iter_mut().for_each(|a| *a *= k);
+                black_box(&fa);
+            }
+        }
+        _ => {
+            for _ in 0..reps {
+                let k = black_box(0.999f32);
+                ca.iter_mut().for_each(|a| *a *= k);
+                black_box(&ca);
+            }
+        }
+    });
+    let n = dirs.len();
+    OpTimes {
+        cp: [
+            ns_per(n, t[0]),
+            ns_per(reps, t[2]),
+            ns_per(reps, t[4]),
+            ns_per(reps, t[6]),
+        ],
+        sh: [
+            ns_per(n, t[1]),
+            ns_per(reps, t[3]),
+            ns_per(reps, t[5]),
+            ns_per(reps, t[7]),
+        ],
+    }
+}
+
 /// The section.
 pub fn section(opts: &Options) -> Result<Section, Box<dyn Error>> {
     let mut rng = Rng::new(SEED);
@@ -623,6 +718,7 @@ pub fn section(opts: &Options) -> Result<Section, Box<dyn Error>> {
     let compare = fit_compare_rows(&mut rng);
     let rotation = rotation_rows(opts, &mut rng);
     let transport = transport_rows(opts);
+    let ops = op_times(opts, &mut rng);
 
     let mut summary = String::new();
     let l3 = query.iter().find(|r| r.level == 3);
@@ -799,6 +895,20 @@ pub fn section(opts: &Options) -> Result<Section, Box<dyn Error>> {
     html.push_str("</table>");
     writeln!(
         html,
+        "<p>Operation times, ns (162 control points, 64 SH coefficients; one rotation in the \
+         table above).</p><table><tr><th></th><th>query</th><th>query, shared weights / \
+         basis</th><th>add</th><th>scale</th></tr><tr><td>control points</td><td>{:.1}</td>\
+         <td>{:.1}</td><td>{:.1}</td><td>{:.1}</td></tr><tr><td>SH</td><td>{:.1}</td>\
+         <td>{:.1}</td><td>{:.1}</td><td>{:.1}</td></tr></table>",
+        ops.cp[0], ops.cp[1], ops.cp[2], ops.cp[3], ops.sh[0], ops.sh[1], ops.sh[2], ops.sh[3]
+    )?;
+    writeln!(
+        summary,
+        "ns per query / shared-weight query / add / scale: 162 CP {:.1} / {:.1} / {:.1} / {:.1}, 64 SH {:.1} / {:.1} / {:.1} / {:.1}",
+        ops.cp[0], ops.cp[1], ops.cp[2], ops.cp[3], ops.sh[0], ops.sh[1], ops.sh[2], ops.sh[3]
+    )?;
+    writeln!(
+        html,
         "<p>Direction-driven transport (section 3.5): a 24³ voxel cube scene, {} surface \
          voxels, diffuse, {} iterations, visibility factored per direction before timing; \
          162 control points against 64 SH coefficients per voxel. The paper: 4 / 10 / 19 / \
@@ -904,6 +1014,10 @@ pub fn section(opts: &Options) -> Result<Section, Box<dyn Error>> {
             "apply_ns": r.apply_ns,
             "worst_match_rad": r.worst_match,
         })).collect::<Vec<_>>(),
+        "ops_ns": {
+            "cp": {"query": ops.cp[0], "shared_query": ops.cp[1], "add": ops.cp[2], "scale": ops.cp[3]},
+            "sh": {"query": ops.sh[0], "shared_query": ops.sh[1], "add": ops.sh[2], "scale": ops.sh[3]},
+        },
         "transport": transport.iter().map(|t| json!({
             "directions": t.directions,
             "links": t.links,

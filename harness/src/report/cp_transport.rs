@@ -265,22 +265,7 @@ impl Representation for Harmonics {
     }
     #[inline]
     fn query(&self, f: &[f32], y: &Vec<f32>) -> f32 {
-        // Eight partial sums, so that the dot product vectorises (a single running sum
-        // would be bound by the latency of 64 dependent additions).
-        let mut acc = [0.0f32; 8];
-        let (fc, yc) = (f.chunks_exact(8), y.chunks_exact(8));
-        let tail: f32 = fc
-            .remainder()
-            .iter()
-            .zip(yc.remainder())
-            .map(|(a, b)| a * b)
-            .sum();
-        for (a, b) in fc.zip(yc) {
-            for k in 0..8 {
-                acc[k] += a[k] * b[k];
-            }
-        }
-        acc.iter().sum::<f32>() + tail
+        dot(f, y)
     }
     fn hemisphere(&self, n: Vec3) -> Vec<f32> {
         // The L2 projection of [n·ω > 0]: the coefficients of the cap of half-angle π/2.
@@ -293,6 +278,26 @@ impl Representation for Harmonics {
         );
         c
     }
+}
+
+/// `Σ a_k b_k` with eight partial sums, so that it vectorises (a single running sum is bound
+/// by the latency of its dependent additions): the SH side's query along a shared direction.
+#[inline]
+pub fn dot(a: &[f32], b: &[f32]) -> f32 {
+    let mut acc = [0.0f32; 8];
+    let (ac, bc) = (a.chunks_exact(8), b.chunks_exact(8));
+    let tail: f32 = ac
+        .remainder()
+        .iter()
+        .zip(bc.remainder())
+        .map(|(x, y)| x * y)
+        .sum();
+    for (x, y) in ac.zip(bc) {
+        for k in 0..8 {
+            acc[k] += x[k] * y[k];
+        }
+    }
+    acc.iter().sum::<f32>() + tail
 }
 
 /// One run: seconds of the timed iterations and the final irradiance per surface voxel.
