@@ -28,8 +28,8 @@ pub const RIDGE: f64 = 1e-10;
 
 /// Bound on `(‖A v − f‖ − ‖A v* − f‖) / ‖f‖` of the fit `v` against an exact minimiser
 /// `v*` (the dense SVD pseudo-inverse), asserted by `tests/cp.rs` on full, sparse and
-/// under-determined sample sets (measured at most 1.2e-16; the SVD minimiser itself is exact
-/// only to about 1e-12, its singular-value cut-off).
+/// under-determined sample sets (the SVD minimiser itself is exact only to about 1e-12, its
+/// singular-value cut-off).
 pub const RESIDUAL_REL_ERROR: f64 = 1e-12;
 
 /// A least-squares fit for fixed sample directions: the design located and `AᵀA + λI`

@@ -449,6 +449,37 @@ fn fit_compare_rows(rng: &mut Rng) -> Vec<FitCompare> {
     rows
 }
 
+/// The relative L2 error of `v0` rotated 0 times and then each of [`ROTATION_STEPS`] times in
+/// succession by `apply` (`value(v, d)` the represented function at `d`), against
+/// `exact(d, steps)`; and the ns per application (median over runs of 100).
+fn rotation_errors(
+    opts: &Options,
+    v0: &[f32],
+    mut apply: impl FnMut(&[f32], &mut [f32]),
+    mut value: impl FnMut(&[f32], Vec3) -> f64,
+    test_dirs: &[Vec3],
+    exact: impl Fn(Vec3, usize) -> f64,
+) -> (Vec<f64>, f64) {
+    let mut v = v0.to_vec();
+    let mut tmp = vec![0.0f32; v.len()];
+    let (mut errors, mut done) = (Vec::new(), 0);
+    for &steps in std::iter::once(&0).chain(ROTATION_STEPS.iter()) {
+        while done < steps {
+            apply(&v, &mut tmp);
+            std::mem::swap(&mut v, &mut tmp);
+            done += 1;
+        }
+        errors.push(rel_l2(test_dirs, |d| value(&v, d), |d| exact(d, steps)));
+    }
+    let t = median_times_in_turns(opts.repeats.min(5), 1, |_| {
+        for _ in 0..100 {
+            apply(black_box(v0), &mut tmp);
+        }
+        black_box(&tmp);
+    });
+    (errors, ns_per(100, t[0]))
+}
+
 fn rotation_rows(opts: &Options, rng: &mut Rng) -> Vec<RotationRow> {
     use steradian_core::cp::rotate::Operator;
     use steradian_core::sh::rotate::{Operator as ShOperator, Rotation};
@@ -497,69 +528,41 @@ fn rotation_rows(opts: &Options, rng: &mut Rng) -> Vec<RotationRow> {
                 .map(|x| *x as f32)
                 .collect();
             for (method, op, worst) in &ops {
-                let mut errors = Vec::new();
-                let mut v = v0.clone();
-                let mut tmp = vec![0.0f32; v.len()];
-                let mut done = 0;
-                for &steps in std::iter::once(&0).chain(ROTATION_STEPS.iter()) {
-                    while done < steps {
-                        op.apply(&v, &mut tmp).expect("lengths");
-                        std::mem::swap(&mut v, &mut tmp);
-                        done += 1;
-                    }
-                    errors.push(rel_l2(
-                        &test_dirs,
-                        |d| f64::from(mesh.query(&v, d, Weights::Area).unwrap_or(f32::NAN)),
-                        |d| f(back(d, steps)),
-                    ));
-                }
-                let t = median_times_in_turns(opts.repeats.min(5), 1, |_| {
-                    for _ in 0..100 {
-                        op.apply(black_box(&v0), &mut tmp).expect("lengths");
-                    }
-                    black_box(&tmp);
-                });
+                let (errors, apply_ns) = rotation_errors(
+                    opts,
+                    &v0,
+                    |v, out| op.apply(v, out).expect("lengths"),
+                    |v, d| f64::from(mesh.query(v, d, Weights::Area).unwrap_or(f32::NAN)),
+                    &test_dirs,
+                    |d, steps| f(back(d, steps)),
+                );
                 rows.push(RotationRow {
                     angle,
                     function: name,
                     method,
                     size: v0.len(),
                     errors,
-                    apply_ns: ns_per(100, t[0]),
+                    apply_ns,
                     worst_match: *worst,
                 });
             }
             let c0 = sh_fit(bands, &sh_dirs, f);
-            let mut c = c0.clone();
-            let mut tmp = vec![0.0f32; c.len()];
-            let mut y = vec![0.0f32; c.len()];
-            let mut errors = Vec::new();
-            let mut done = 0;
-            for &steps in std::iter::once(&0).chain(ROTATION_STEPS.iter()) {
-                while done < steps {
-                    sh_op.apply(&c, &mut tmp).expect("lengths");
-                    std::mem::swap(&mut c, &mut tmp);
-                    done += 1;
-                }
-                errors.push(rel_l2(
-                    &test_dirs,
-                    |d| sh_value(&c, bands, d, &mut y),
-                    |d| f(back(d, steps)),
-                ));
-            }
-            let t = median_times_in_turns(opts.repeats.min(5), 1, |_| {
-                for _ in 0..100 {
-                    sh_op.apply(black_box(&c0), &mut tmp).expect("lengths");
-                }
-                black_box(&tmp);
-            });
+            let mut y = vec![0.0f32; c0.len()];
+            let (errors, apply_ns) = rotation_errors(
+                opts,
+                &c0,
+                |c, out| sh_op.apply(c, out).expect("lengths"),
+                |c, d| sh_value(c, bands, d, &mut y),
+                &test_dirs,
+                |d, steps| f(back(d, steps)),
+            );
             rows.push(RotationRow {
                 angle,
                 function: name,
                 method: "SH operator (Ivanic–Ruedenberg)",
                 size: c0.len(),
                 errors,
-                apply_ns: ns_per(100, t[0]),
+                apply_ns,
                 worst_match: None,
             });
         }
