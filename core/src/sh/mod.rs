@@ -33,15 +33,16 @@
 //!   Π_l^m = a_l^m·(z·Π_{l−1}^m − b_l^m·Π_{l−2}^m),  a_l^m = √((4l²−1)/(l²−m²)),  b_l^m = 1/a_{l−1}^m
 //! ```
 //!
-//! The coefficients are computed in `f64` at compile time ([`A`], [`B`], [`DIAG`], [`SUB`]:
-//! no table file, no square root at run time) and kept in `f64`. The recurrence
-//! itself runs in its homogeneous form, `Π_l^m = a_l^m·(z·Π_{l−1}^m − b_l^m·r²·Π_{l−2}^m)`
-//! with `r² = x² + y² + z²` of the given point, so that an `f32` unit vector's distance from
-//! the sphere (a few `1e-8`) scales band `l` by `r^l` instead of being amplified by the
-//! Legendre polynomials' large coefficients (with `1 − z²` in place of `x² + y²` that
-//! inconsistency alone costs `5e-5` at 30 bands near the poles). Cost per direction: about
-//! seven multiplications per coefficient, no division or square root after the
-//! normalisation of the direction.
+//! The coefficients are computed in `f64` at compile time ([`A`], [`AB`] `= a·b`, [`DIAG`],
+//! [`SUB`]: no table file, no square root at run time) and kept in `f64`; a step is
+//! `Π_l^m = (a_l^m·z)·Π_{l−1}^m − (a_l^m·b_l^m)·Π_{l−2}^m`, one multiply and one subtract on
+//! the dependency chain. It runs on the direction normalised in `f64`, where
+//! `x² + y² + z² = 1` to `3e-16`: the `1 − z²` that the textbook form eliminates through
+//! that identity costs nothing (in `f32` the same inconsistency, a few `1e-8`, is amplified
+//! by the Legendre polynomials' large coefficients to `5e-5` at 30 bands near the poles,
+//! one reason the recurrence is not run in `f32`). Cost per direction: about seven
+//! multiplications per coefficient, no division or square root after the normalisation of
+//! the direction.
 //!
 //! **Precision: `f64` inside, `f32` in and out.** The crate's kernels compute in `f32`; this
 //! one normalises the `f32` direction in `f64`, runs its recurrence in `f64` with `f64`
@@ -73,8 +74,8 @@
 //!
 //! ## Bad input
 //!
-//! The direction need not be unit: it is scaled by its largest component and normalised
-//! (no overflow for huge or tiny vectors). The zero vector evaluates at the pole `+z`; a
+//! The direction need not be unit: it is normalised in `f64`, where no `f32` vector
+//! overflows or underflows. The zero vector evaluates at the pole `+z`; a
 //! non-finite direction gives NaN in every value. A band count above [`MAX_BANDS`] or an
 //! output slice shorter than `n²` is an error, not a panic.
 //!
@@ -197,14 +198,19 @@ const fn table_a() -> [f64; TRI] {
     t
 }
 
-const fn table_b() -> [f64; TRI] {
+const fn table_ab() -> [f64; TRI] {
     let mut t = [0.0f64; TRI];
     let mut l = 2;
     while l < MAX_BANDS {
         let mut m = 0;
         while m + 2 <= l {
-            let (l1, mf) = ((l - 1) as f64, m as f64);
-            t[tri(l, m)] = sqrt_const((l1 * l1 - mf * mf) / (4.0 * l1 * l1 - 1.0));
+            let (lf, l1, mf) = (l as f64, (l - 1) as f64, m as f64);
+            // a·b = √((4l²−1)·((l−1)²−m²) / ((l²−m²)·(4(l−1)²−1))): integers below 2^53,
+            // one rounding of the quotient, one of the root.
+            t[tri(l, m)] = sqrt_const(
+                ((4.0 * lf * lf - 1.0) * (l1 * l1 - mf * mf))
+                    / ((lf * lf - mf * mf) * (4.0 * l1 * l1 - 1.0)),
+            );
             m += 1;
         }
         l += 1;
@@ -235,8 +241,9 @@ const fn table_sub() -> [f64; MAX_BANDS] {
 
 /// `a_l^m = √((4l²−1)/(l²−m²))` at `tri(l, m)` for `l ≥ m + 2` (0 elsewhere).
 pub static A: [f64; TRI] = table_a();
-/// `b_l^m = √(((l−1)²−m²)/(4(l−1)²−1))` at `tri(l, m)` for `l ≥ m + 2` (0 elsewhere).
-pub static B: [f64; TRI] = table_b();
+/// `a_l^m·b_l^m = √((4l²−1)·((l−1)²−m²) / ((l²−m²)·(4(l−1)²−1)))` at `tri(l, m)` for
+/// `l ≥ m + 2` (0 elsewhere): the recurrence's second coefficient, `b_l^m = 1/a_{l−1}^m`.
+pub static AB: [f64; TRI] = table_ab();
 /// `−√((2m+1)/(2m))` at `m ≥ 1`: `Π_m^m = DIAG[m]·Π_{m−1}^{m−1}`.
 pub static DIAG: [f64; MAX_BANDS] = table_diag();
 /// `√(2m+3)`: `Π_{m+1}^m = SUB[m]·z·Π_m^m`.
@@ -244,21 +251,52 @@ pub static SUB: [f64; MAX_BANDS] = table_sub();
 
 // ---- Evaluation --------------------------------------------------------------------------
 
-/// `d` scaled by its largest component and normalised, in `f64` (so the direction the
-/// recurrence sees is the input's to `1e-16`, not to the `6e-8` of an `f32` unit vector,
-/// which alone would cost `3e-6` at 30 bands); the zero vector → `+z`; NaN for a
-/// non-finite component.
+/// `d` normalised in `f64` (so the direction the recurrence sees is the input's to `3e-16`,
+/// not to the `6e-8` of an `f32` unit vector, which alone would cost `3e-6` at 30 bands);
+/// the zero vector → `+z`; NaN for a non-finite component.
+///
+/// `r² = x² + y² + z²` of an `f32` vector cannot overflow or underflow in `f64`
+/// (`3·f32::MAX² ≈ 3.5e77`, the smallest subnormal squared `2e-90`), so no pre-scaling is
+/// needed; the direction is `d·(1/√r²)`: one square root, one division, three products, so
+/// that the SIMD twin ([`unit_direction`]'s lanes in `steradian_simd::sh`) performs the
+/// same correctly rounded operations and gets the same bits.
 #[inline]
 pub fn unit_direction(d: Vec3) -> DVec3 {
-    if !d.is_finite() {
-        return DVec3::splat(f64::NAN);
-    }
-    let m = d.x.abs().max(d.y.abs()).max(d.z.abs());
-    if m == 0.0 {
+    let (x, y, z) = (f64::from(d.x), f64::from(d.y), f64::from(d.z));
+    let r2 = x * x + y * y + z * z;
+    if r2 == 0.0 {
         return DVec3::Z;
     }
-    let s = d.as_dvec3() / f64::from(m);
-    s / math::sqrt64(s.dot(s))
+    // Non-finite input ⟺ r² is ∞ or NaN (a finite f32 vector has a finite r² in f64).
+    if !r2.is_finite() {
+        return DVec3::splat(f64::NAN);
+    }
+    let inv = 1.0 / math::sqrt64(r2);
+    DVec3::new(x * inv, y * inv, z * inv)
+}
+
+/// Orders `m` whose recurrences in `l` run together in one pass of [`eval_into`] (and of
+/// its SIMD twin): four independent chains hide the latency of each one's multiply and
+/// subtract. Part of the kernel's definition only through speed: every value is computed by
+/// the same operations whatever the grouping.
+pub const CHAINS: usize = 4;
+
+/// The most orders one pass takes: the last pass takes all that remain when they are at
+/// most `CHAINS + 2`, so that no pass is left with one or two short chains.
+pub const MAX_GROUP: usize = CHAINS + 2;
+
+/// The number of orders the next pass takes when `left` remain.
+#[inline(always)]
+pub const fn group(left: usize) -> usize {
+    if left <= MAX_GROUP { left } else { CHAINS }
+}
+
+/// One step of the recurrence, `Π_l^m = (a_l^m·z)·Π_{l−1}^m − (a_l^m·b_l^m)·Π_{l−2}^m` at
+/// `k = tri(l, m)`: the coefficient products are off the chain, so each step adds one
+/// multiply and one subtract of latency.
+#[inline(always)]
+fn step(k: usize, z: f64, q1: f64, q2: f64) -> f64 {
+    A[k] * z * q1 - AB[k] * q2
 }
 
 /// The recurrence over `bands` bands at the unit direction `d` into `out[..bands²]`
@@ -266,87 +304,91 @@ pub fn unit_direction(d: Vec3) -> DVec3 {
 /// fixed-size and the dynamic entry points, so both give the same bits.
 ///
 /// The recurrence runs in `f64`, one rounding to `f32` per output (module docs,
-/// "Accuracy"), in its homogeneous form `Π_l = a·(z·Π_{l−1} − b·r²·Π_{l−2})`.
+/// "Accuracy"), on the `f64` unit vector, where `x² + y² + z² = 1` to `3e-16`; the
+/// homogeneous `r²` of an unnormalised point is therefore left out.
 ///
-/// **Two chains at a time.** The recurrence in `l` is a chain of dependent multiplications
-/// per `m` (about 12 cycles of latency per step), so one chain at a time leaves the
-/// arithmetic units idle; the orders `m` and `m + 1` run in the same loop, their steps
-/// independent. Each value is computed by the same operations in the same order as one
-/// chain at a time, so the bits do not depend on the pairing (the SIMD twin pairs the
-/// chains the same way over four directions and is tested bit for bit). The report's SH
-/// section times it.
+/// **[`CHAINS`] orders at a time.** The recurrence in `l` is a chain of dependent
+/// operations per order `m`, so the orders `m0 .. m0 + 3` run in the same loop over `l`,
+/// their steps independent (the last pass takes up to [`MAX_GROUP`] orders, see
+/// [`group`]). Order `m`'s chain starts at `Π_m^m` (`Π_0^0` for `m = 0`,
+/// `√2·Π_m^m` for `m ≥ 1`, the `√2` of the real functions carried by the chain) and
+/// `Π_{m+1}^m = √(2m+3)·z·Π_m^m`; every value goes out as `q·S_m` at `l² + l − m` and then
+/// `q·C_m` at `l² + l + m` (for `m = 0`, `C = 1` and `S = 0` make the second write the
+/// value itself). The SIMD twin does the same operations in the same order and is tested
+/// bit for bit.
 #[inline(always)]
 fn fill(d: DVec3, bands: usize, out: &mut [f32]) {
     let out = &mut out[..bands * bands];
     if bands == 0 {
         return;
     }
-    // `+ 0·z`: NaN for a NaN direction (crate convention), exactly `Y00` otherwise.
-    out[0] = (Y00_F64 + 0.0 * d.z) as f32;
-    if bands == 1 {
-        return;
-    }
     let (x, y, z) = (d.x, d.y, d.z);
-    let r2 = x * x + y * y + z * z;
-    let y00 = Y00_F64;
-    // m = 0: Π_l^0 directly.
-    let (mut p2, mut p1) = (y00, SUB[0] * z * y00);
-    out[2] = p1 as f32;
-    for l in 2..bands {
-        let k = tri(l, 0);
-        let p = A[k] * (z * p1 - B[k] * r2 * p2);
-        out[l * l + l] = p as f32;
-        (p2, p1) = (p1, p);
+    let (mut pmm, mut c, mut s) = (Y00_F64, 1.0f64, 0.0f64);
+    let mut m0 = 0;
+    while m0 < bands {
+        let g = group(bands - m0);
+        // Each order's angular factors and the chain's first value.
+        let (mut cc, mut ss) = ([1.0f64; MAX_GROUP], [0.0f64; MAX_GROUP]);
+        let (mut q1, mut q2) = ([0.0f64; MAX_GROUP], [0.0f64; MAX_GROUP]);
+        for j in 0..g {
+            let m = m0 + j;
+            if m > 0 {
+                pmm *= DIAG[m];
+                (c, s) = (x * c - y * s, x * s + y * c);
+            }
+            (cc[j], ss[j]) = (c, s);
+            q1[j] = if m == 0 {
+                Y00_F64
+            } else {
+                core::f64::consts::SQRT_2 * pmm
+            };
+        }
+        // The first rows, one chain after the other: chain j starts at row m0 + j and
+        // steps from row m0 + j + 2.
+        let head = (m0 + g + 1).min(bands);
+        for j in 0..g {
+            let m = m0 + j;
+            let (mut p1, mut p2) = (q1[j], 0.0);
+            for l in m..head {
+                let q = if l == m {
+                    p1
+                } else if l == m + 1 {
+                    SUB[m] * z * p1
+                } else {
+                    step(tri(l, m), z, p1, p2)
+                };
+                if l > m {
+                    (p2, p1) = (p1, q);
+                }
+                let at = l * l + l;
+                out[at - m] = (q * ss[j]) as f32;
+                out[at + m] = (q * cc[j]) as f32;
+            }
+            (q1[j], q2[j]) = (p1, p2);
+        }
+        // The rest: every chain steps (only groups of `CHAINS` reach here: the last group,
+        // of any other size, takes every remaining order, so its head ends at `bands`).
+        for l in head..bands {
+            let at = l * l + l;
+            let k = tri(l, m0);
+            let (a, ab) = (&A[k..k + CHAINS], &AB[k..k + CHAINS]);
+            let (mut sin, mut cos) = ([0.0f32; CHAINS], [0.0f32; CHAINS]);
+            for j in 0..CHAINS {
+                let q = a[j] * z * q1[j] - ab[j] * q2[j];
+                (q2[j], q1[j]) = (q1[j], q);
+                sin[CHAINS - 1 - j] = (q * ss[j]) as f32;
+                cos[j] = (q * cc[j]) as f32;
+            }
+            // Orders m0 + 3 … m0 below the centre, m0 … m0 + 3 above (they meet at the
+            // centre only for m0 = 0, where the cosine part, written last, is the value).
+            let lo = at - m0 - (CHAINS - 1);
+            out[lo..lo + CHAINS].copy_from_slice(&sin);
+            out[at + m0..at + m0 + CHAINS].copy_from_slice(&cos);
+        }
+        m0 += g;
     }
-    // m ≥ 1: √2·Π_l^m times C_m and S_m, two orders per pass.
-    let put = |out: &mut [f32], l: usize, m: usize, q: f64, c: f64, s: f64| {
-        let at = l * l + l;
-        out[at + m] = (q * c) as f32;
-        out[at - m] = (q * s) as f32;
-    };
-    let step = |l: usize, m: usize, q1: f64, q2: f64| {
-        let k = tri(l, m);
-        A[k] * (z * q1 - B[k] * r2 * q2)
-    };
-    let (mut pmm, mut c, mut s) = (y00, 1.0f64, 0.0f64);
-    let mut m = 1;
-    while m < bands {
-        // Order m.
-        pmm *= DIAG[m];
-        (c, s) = (x * c - y * s, x * s + y * c);
-        let (ca, sa) = (c, s);
-        let mut a2 = core::f64::consts::SQRT_2 * pmm;
-        put(out, m, m, a2, ca, sa);
-        if m + 1 == bands {
-            break;
-        }
-        let mut a1 = SUB[m] * z * a2;
-        put(out, m + 1, m, a1, ca, sa);
-        // Order m + 1 (it exists: m + 1 < bands).
-        pmm *= DIAG[m + 1];
-        (c, s) = (x * c - y * s, x * s + y * c);
-        let (cb, sb) = (c, s);
-        let mut b2 = core::f64::consts::SQRT_2 * pmm;
-        put(out, m + 1, m + 1, b2, cb, sb);
-        if m + 2 == bands {
-            break;
-        }
-        let q = step(m + 2, m, a1, a2);
-        put(out, m + 2, m, q, ca, sa);
-        (a2, a1) = (a1, q);
-        let mut b1 = SUB[m + 1] * z * b2;
-        put(out, m + 2, m + 1, b1, cb, sb);
-        // Both chains together.
-        for l in m + 3..bands {
-            let qa = step(l, m, a1, a2);
-            let qb = step(l, m + 1, b1, b2);
-            put(out, l, m, qa, ca, sa);
-            put(out, l, m + 1, qb, cb, sb);
-            (a2, a1) = (a1, qa);
-            (b2, b1) = (b1, qb);
-        }
-        m += 2;
-    }
+    // `+ 0·z`: NaN for a NaN direction (crate convention), exactly `Y00` otherwise.
+    out[0] = (Y00_F64 + 0.0 * z) as f32;
 }
 
 /// All `bands²` real SH at `dir` (any non-zero length; module docs) into `out[..bands²]`.
@@ -354,7 +396,22 @@ fn fill(d: DVec3, bands: usize, out: &mut [f32]) {
 /// Errors: `bands > MAX_BANDS`, or `out` shorter than `bands²`.
 pub fn eval_into(dir: Vec3, bands: usize, out: &mut [f32]) -> Result<(), Error> {
     check_shape(bands, out.len())?;
-    fill(unit_direction(dir), bands, out);
+    let d = unit_direction(dir);
+    // Straight-line code for the band counts renderers use most: with the count a constant
+    // the compiler unrolls the loops of `fill` and drops their branches (same operations,
+    // same bits).
+    match bands {
+        2 => fill(d, 2, out),
+        3 => fill(d, 3, out),
+        4 => fill(d, 4, out),
+        5 => fill(d, 5, out),
+        6 => fill(d, 6, out),
+        7 => fill(d, 7, out),
+        8 => fill(d, 8, out),
+        9 => fill(d, 9, out),
+        10 => fill(d, 10, out),
+        _ => fill(d, bands, out),
+    }
     Ok(())
 }
 
@@ -492,8 +549,10 @@ mod tests {
                 let (lf, mf) = (l as f64, m as f64);
                 let a = ((4.0 * lf * lf - 1.0) / (lf * lf - mf * mf)).sqrt();
                 let l1 = lf - 1.0;
-                let b = ((l1 * l1 - mf * mf) / (4.0 * l1 * l1 - 1.0)).sqrt();
-                assert_eq!((A[tri(l, m)], B[tri(l, m)]), (a, b), "l {l} m {m}");
+                let ab = (((4.0 * lf * lf - 1.0) * (l1 * l1 - mf * mf))
+                    / ((lf * lf - mf * mf) * (4.0 * l1 * l1 - 1.0)))
+                    .sqrt();
+                assert_eq!((A[tri(l, m)], AB[tri(l, m)]), (a, ab), "l {l} m {m}");
             }
         }
         for m in 1..MAX_BANDS {
