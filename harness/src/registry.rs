@@ -369,9 +369,7 @@ pub const KERNELS: &[KernelSpec] = &[
         contract: r#"{"dir": [x,y,z] non-zero, "half_angle": a in [0, π], "bands": n in 1..=128} -> {"coeffs": [n² values of ∫_cap Y_l^m dω]}"#,
         eval: Piece::At(handlers::sh_cap),
         scalar: "steradian_core::sh::cap::coefficients_into",
-        simd: Piece::Without(
-            "not written yet: one cap per call is the HVL use; a batch comes with HVL shading",
-        ),
+        simd: Piece::At("steradian_simd::sh::cap::coefficients_slices"),
         wgsl: Piece::Without("not written yet (WGSL has no f64; see sh-eval)"),
         reference: Piece::At("steradian_reference::sh::cap_zonal"),
         bound: Piece::At(Bound {
@@ -388,7 +386,7 @@ pub const KERNELS: &[KernelSpec] = &[
         contract: r#"{"coeffs": [n² radiance coefficients], "normal": [x,y,z] non-zero} -> {"irradiance": E = ∫ L·max(n·ω,0) dω (not /π)}"#,
         eval: Piece::At(handlers::sh_irradiance),
         scalar: "steradian_core::sh::irradiance::irradiance",
-        simd: Piece::Without("not written yet: one dot product per normal after sh-eval"),
+        simd: Piece::At("steradian_simd::sh::irradiance::irradiance_slices"),
         wgsl: Piece::Without("not written yet (WGSL has no f64; see sh-eval)"),
         reference: Piece::At("steradian_reference::sh::irradiance"),
         bound: Piece::At(Bound {

@@ -172,3 +172,193 @@ fn rotation_operator_lanes_equal_the_scalar_kernel() {
         .is_err()
     );
 }
+
+/// `coefficients_slices` on caps `(axis, half-angle)` against the scalar
+/// `coefficients_into`, bit for bit, every coefficient of every cap.
+fn check_caps(caps: &[(Vec3, f32)], bands: usize) {
+    let n = caps.len();
+    let col = |f: &dyn Fn(&(Vec3, f32)) -> f32| caps.iter().map(f).collect::<Vec<f32>>();
+    let (x, y, z, a) = (
+        col(&|c| c.0.x),
+        col(&|c| c.0.y),
+        col(&|c| c.0.z),
+        col(&|c| c.1),
+    );
+    let mut out = vec![0.0; bands * bands * n];
+    steradian_simd::sh::cap::coefficients_slices(&x, &y, &z, &a, bands, &mut out)
+        .expect("valid caps");
+    let mut want = vec![0.0; bands * bands];
+    for (i, (axis, half)) in caps.iter().enumerate() {
+        sh::cap::coefficients_into(*axis, *half, bands, &mut want).expect("valid cap");
+        for (k, w) in want.iter().enumerate() {
+            let got = out[k * n + i];
+            assert!(
+                same(got, *w),
+                "{axis} {half} bands {bands} k {k}: {got} vs {w}"
+            );
+        }
+    }
+}
+
+#[test]
+fn cap_lanes_equal_the_scalar_kernel() {
+    let mut rng = Rng(0x0c0a);
+    // Half-angles from 1e-4 rad (the small-cap case) to π (the whole sphere), the hemisphere.
+    let angles = [
+        0.0f32,
+        1e-4,
+        1e-3,
+        0.3,
+        core::f32::consts::FRAC_PI_2,
+        2.5,
+        core::f32::consts::PI,
+    ];
+    for bands in [0usize, 1, 3, 5, 10, 30] {
+        for len in LENGTHS {
+            let caps: Vec<(Vec3, f32)> = (0..len)
+                .map(|i| {
+                    (
+                        rng.dir() * rng.log_range(1e-3, 1e3),
+                        angles[i % angles.len()],
+                    )
+                })
+                .collect();
+            check_caps(&caps, bands);
+        }
+    }
+    // Special values in the axis, every component and lane position; the poles, zero axis.
+    let rows: Vec<(Vec3, f32)> = in_each_component()
+        .into_iter()
+        .chain([Vec3::Z, -Vec3::Z, Vec3::ZERO])
+        .map(|d| (d, 0.7))
+        .collect();
+    in_every_lane(&rows, (Vec3::new(0.2, -0.3, 0.9), 0.2), |r| {
+        check_caps(r, 6)
+    });
+    // A bad half-angle in any lane is an error, as the scalar kernel's for that cap.
+    for bad in [f32::NAN, -0.1, 3.2, f32::INFINITY] {
+        let mut out = vec![0.0; 9 * 5];
+        let a = [0.5, 0.5, bad, 0.5, 0.5];
+        assert!(
+            steradian_simd::sh::cap::coefficients_slices(
+                &[0.0; 5], &[0.0; 5], &[1.0; 5], &a, 3, &mut out
+            )
+            .is_err(),
+            "{bad}"
+        );
+        assert!(sh::cap::coefficients_into(Vec3::Z, bad, 3, &mut [0.0; 9]).is_err());
+    }
+    let mut out = vec![0.0; 9 * 2];
+    assert!(
+        steradian_simd::sh::cap::coefficients_slices(
+            &[0.0; 2],
+            &[0.0; 2],
+            &[1.0; 2],
+            &[0.5],
+            3,
+            &mut out
+        )
+        .is_err()
+    );
+    let mut short = vec![[0.0f32; 4]; 8];
+    assert!(
+        steradian_simd::sh::cap::coefficients_x4([Vec3::Z; 4], [0.5; 4], 3, &mut short).is_err()
+    );
+}
+
+/// `irradiance_slices` at `normals` against the scalar `irradiance`, bit for bit.
+fn check_irradiance(radiance: &[f32], normals: &[Vec3]) {
+    let n = normals.len();
+    let bands = sh::bands_of(radiance.len()).expect("square");
+    let col = |f: fn(&Vec3) -> f32| normals.iter().map(f).collect::<Vec<f32>>();
+    let (x, y, z) = (col(|d| d.x), col(|d| d.y), col(|d| d.z));
+    let mut scratch = vec![[0.0f32; 4]; bands * bands];
+    let mut out = vec![0.0; n];
+    steradian_simd::sh::irradiance::irradiance_slices(radiance, &x, &y, &z, &mut scratch, &mut out)
+        .expect("valid shapes");
+    let mut basis = vec![0.0; bands * bands];
+    for (i, d) in normals.iter().enumerate() {
+        let want = sh::irradiance::irradiance(radiance, *d, &mut basis).expect("valid");
+        assert!(
+            same(out[i], want),
+            "{d} bands {bands}: {} vs {want}",
+            out[i]
+        );
+    }
+}
+
+#[test]
+fn irradiance_lanes_equal_the_scalar_kernel() {
+    let mut rng = Rng(0x1aad);
+    for bands in [1usize, 2, 3, 5, 9, 30] {
+        let radiance: Vec<f32> = (0..bands * bands).map(|_| rng.range(-1.0, 2.0)).collect();
+        for len in LENGTHS {
+            let normals: Vec<Vec3> = (0..len)
+                .map(|_| rng.dir() * rng.log_range(1e-3, 1e3))
+                .collect();
+            check_irradiance(&radiance, &normals);
+        }
+    }
+    let radiance: Vec<f32> = (0..16).map(|k| (k as f32 * 0.61).cos()).collect();
+    let rows: Vec<Vec3> = in_each_component()
+        .into_iter()
+        .chain([Vec3::Z, -Vec3::Z, Vec3::X, Vec3::ZERO])
+        .collect();
+    in_every_lane(&rows, Vec3::new(0.2, -0.3, 0.9), |r| {
+        check_irradiance(&radiance, r)
+    });
+    // A special value in the radiance reaches every normal as it does in the scalar kernel.
+    for &sp in SPECIALS.iter() {
+        let mut odd = radiance.clone();
+        odd[5] = sp;
+        check_irradiance(&odd, &rows);
+    }
+    // Shapes: not a square, a short scratch, columns of different lengths.
+    let mut scratch = vec![[0.0f32; 4]; 16];
+    let mut out = vec![0.0; 3];
+    let irr = steradian_simd::sh::irradiance::irradiance_slices;
+    assert!(
+        irr(
+            &[0.0; 15],
+            &[0.0; 3],
+            &[0.0; 3],
+            &[1.0; 3],
+            &mut scratch,
+            &mut out
+        )
+        .is_err()
+    );
+    assert!(
+        irr(
+            &[0.0; 25],
+            &[0.0; 3],
+            &[0.0; 3],
+            &[1.0; 3],
+            &mut scratch,
+            &mut out
+        )
+        .is_err()
+    );
+    assert!(
+        irr(
+            &[0.0; 16],
+            &[0.0; 3],
+            &[0.0; 2],
+            &[1.0; 3],
+            &mut scratch,
+            &mut out
+        )
+        .is_err()
+    );
+    assert!(
+        irr(
+            &[0.0; 16],
+            &[0.0; 3],
+            &[0.0; 3],
+            &[1.0; 3],
+            &mut scratch,
+            &mut out
+        )
+        .is_ok()
+    );
+}

@@ -123,13 +123,32 @@ pub fn coefficients_into(
 ) -> Result<(), Error> {
     check(half_angle, bands, out.len(), bands * bands)?;
     eval_into(axis, bands, out)?;
-    zonal_each(half_angle, bands, |l, z| {
-        let k = math::sqrt64(4.0 * core::f64::consts::PI / (2.0 * l as f64 + 1.0)) * z;
+    band_scales(half_angle, bands, |l, k| {
         for v in &mut out[l * l..(l + 1) * (l + 1)] {
             *v = (f64::from(*v) * k) as f32;
         }
     });
     Ok(())
+}
+
+/// Calls `f(l, k_l)` for `l < bands` with `k_l = √(4π/(2l+1))·L̃_l`, the factor that turns
+/// the SH basis at the cap's axis into the cap's coefficients of band `l` (eq. 15: rotating
+/// a zonal function to the axis `d` multiplies `Y_l^m(d)` by `√(4π/(2l+1))·L̃_l`); the
+/// argument is not checked (the callers check it). [`coefficients_into`] and its SIMD twin
+/// scale by these same `f64` values, one product and one rounding per coefficient.
+pub fn band_scales(half_angle: f32, bands: usize, mut f: impl FnMut(usize, f64)) {
+    zonal_each(half_angle, bands, |l, z| {
+        f(
+            l,
+            math::sqrt64(4.0 * core::f64::consts::PI / (2.0 * l as f64 + 1.0)) * z,
+        )
+    });
+}
+
+/// The checks of [`coefficients_into`] for `bands²` outputs in `len` values: the half-angle
+/// in `[0, π]`, `bands ≤ MAX_BANDS`, `len ≥ bands²`.
+pub fn check_coefficients(half_angle: f32, bands: usize, len: usize) -> Result<(), Error> {
+    check(half_angle, bands, len, bands * bands)
 }
 
 #[cfg(all(test, feature = "alloc"))]

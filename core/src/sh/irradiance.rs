@@ -64,15 +64,19 @@ pub fn clamped_cosine(l: usize) -> f64 {
 pub fn irradiance(radiance: &[f32], normal: Vec3, scratch: &mut [f32]) -> Result<f32, Error> {
     let bands = bands_of(radiance.len())?;
     eval_into(normal, bands, scratch)?;
+    // In f64, band by band, each band's products summed in index order from +0 (the SIMD
+    // twin, `steradian_simd::sh::irradiance`, adds in the same order).
     let mut e = 0.0f64;
     for l in 0..bands {
         let a = clamped_cosine(l);
         if a == 0.0 {
             continue;
         }
-        let band: f64 = (l * l..(l + 1) * (l + 1))
-            .map(|i| f64::from(radiance[i]) * f64::from(scratch[i]))
-            .sum();
+        let span = l * l..(l + 1) * (l + 1);
+        let mut band = 0.0f64;
+        for (r, y) in radiance[span.clone()].iter().zip(&scratch[span]) {
+            band += f64::from(*r) * f64::from(*y);
+        }
         e += a * band;
     }
     Ok(e as f32)
