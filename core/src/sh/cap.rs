@@ -134,15 +134,39 @@ pub fn coefficients_into(
 /// Calls `f(l, k_l)` for `l < bands` with `k_l = √(4π/(2l+1))·L̃_l`, the factor that turns
 /// the SH basis at the cap's axis into the cap's coefficients of band `l` (eq. 15: rotating
 /// a zonal function to the axis `d` multiplies `Y_l^m(d)` by `√(4π/(2l+1))·L̃_l`); the
-/// argument is not checked (the callers check it). [`coefficients_into`] and its SIMD twin
-/// scale by these same `f64` values, one product and one rounding per coefficient.
+/// argument is not checked (the callers check it). With the zonal form of the module docs
+/// the square roots cancel: `k_0 = 4π·sin²(a/2)`, `k_l = 2π·sin²a·P_l′(cos a)/(l(l+1))`.
+/// [`coefficients_into`] and its SIMD twin scale by these same `f64` values, one product
+/// and one rounding per coefficient; the twin runs this recurrence on `f64` lanes from
+/// [`cap_trig`].
 pub fn band_scales(half_angle: f32, bands: usize, mut f: impl FnMut(usize, f64)) {
-    zonal_each(half_angle, bands, |l, z| {
-        f(
-            l,
-            math::sqrt64(4.0 * core::f64::consts::PI / (2.0 * l as f64 + 1.0)) * z,
-        )
-    });
+    if bands == 0 {
+        return;
+    }
+    let [h2, s2, x] = cap_trig(half_angle);
+    let pi = core::f64::consts::PI;
+    f(0, 4.0 * pi * h2);
+    let (mut p_prev, mut p) = (1.0f64, x);
+    let (mut dp_prev, mut dp) = (0.0f64, 1.0f64);
+    for l in 1..bands {
+        let lf = l as f64;
+        f(l, 2.0 * pi * s2 * dp / (lf * (lf + 1.0)));
+        let p_next = ((2.0 * lf + 1.0) * x * p - lf * p_prev) / (lf + 1.0);
+        let dp_next = dp_prev + (2.0 * lf + 1.0) * p;
+        (p_prev, p) = (p, p_next);
+        (dp_prev, dp) = (dp, dp_next);
+    }
+}
+
+/// `[sin²(a/2), sin²a, cos a]` of the half-angle `a` in `f64` from one sine and one cosine
+/// of `a/2` (`sin a = 2·sin(a/2)·cos(a/2)`, `cos a = 1 − 2·sin²(a/2)`): the start of
+/// [`band_scales`], shared with its SIMD twin.
+#[inline]
+pub fn cap_trig(half_angle: f32) -> [f64; 3] {
+    let h = 0.5 * f64::from(half_angle);
+    let (sh, ch) = (math::sin64(h), math::cos64(h));
+    let s = 2.0 * sh * ch;
+    [sh * sh, s * s, 1.0 - 2.0 * sh * sh]
 }
 
 /// The checks of [`coefficients_into`] for `bands²` outputs in `len` values: the half-angle
@@ -171,6 +195,24 @@ mod tests {
         3.0,
         core::f32::consts::PI,
     ];
+
+    /// The band factors are `√(4π/(2l+1))` times the zonal coefficients (the square roots
+    /// cancel in their closed form), to `f64` rounding: relative, or of the cap's solid
+    /// angle where a factor vanishes (`cos a` near 0 comes from `1 − 2·sin²(a/2)`).
+    #[test]
+    fn band_scales_are_the_rotated_zonal_factors() {
+        let n = 30;
+        for a in ANGLES {
+            let mut zonal = vec![0.0f64; n];
+            zonal_each(a, n, |l, z| zonal[l] = z);
+            band_scales(a, n, |l, k| {
+                let want = (4.0 * core::f64::consts::PI / (2.0 * l as f64 + 1.0)).sqrt() * zonal[l];
+                let omega = 4.0 * core::f64::consts::PI * (0.5 * f64::from(a)).sin().powi(2);
+                let tol = 1e-12 * want.abs() + 1e-14 * omega;
+                assert!((k - want).abs() <= tol, "a {a} l {l}: {k:e} vs {want:e}");
+            });
+        }
+    }
 
     #[test]
     fn zonal_keeps_relative_accuracy_from_1e_4_rad_to_pi() {

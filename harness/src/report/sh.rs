@@ -203,20 +203,44 @@ fn rotate_rows(opts: &Options) -> Vec<RotateRow> {
         .collect()
 }
 
-fn cap_rows(opts: &Options) -> Vec<(usize, f64)> {
+/// Per band count: ns per cap, scalar and SIMD (`coefficients_slices` over 64-cap chunks),
+/// taking turns on the same caps.
+fn cap_rows(opts: &Options) -> Vec<(usize, f64, f64)> {
     let dirs = study::directions(opts.scaled(4096).max(64), SEED ^ 1);
+    let angle = |i: usize| 0.01 + (i % 100) as f32 * 0.01;
+    let angles: Vec<f32> = (0..dirs.len()).map(angle).collect();
+    let col = |k: usize| dirs.iter().map(|d| d[k]).collect::<Vec<f32>>();
+    let (x, y, z) = (col(0), col(1), col(2));
     [3usize, 5, 9]
         .iter()
         .map(|&n| {
             let mut out = vec![0.0f32; n * n];
-            let t = median_time(opts.repeats, || {
-                for (i, d) in dirs.iter().enumerate() {
-                    let a = 0.01 + (i % 100) as f32 * 0.01;
-                    sh::cap::coefficients_into(Vec3::from(*d), a, n, &mut out).expect("shape");
-                    black_box(&out);
+            let chunk = 64;
+            let mut cols = vec![0.0f32; n * n * chunk];
+            let t = median_times_in_turns(opts.repeats, 2, |k| {
+                if k == 0 {
+                    for (i, d) in dirs.iter().enumerate() {
+                        sh::cap::coefficients_into(Vec3::from(*d), angle(i), n, &mut out)
+                            .expect("shape");
+                        black_box(&out);
+                    }
+                } else {
+                    for s in (0..dirs.len()).step_by(chunk) {
+                        let e = (s + chunk).min(dirs.len());
+                        steradian_simd::sh::cap::coefficients_slices(
+                            &x[s..e],
+                            &y[s..e],
+                            &z[s..e],
+                            &angles[s..e],
+                            n,
+                            &mut cols[..n * n * (e - s)],
+                        )
+                        .expect("shape");
+                        black_box(&cols);
+                    }
                 }
             });
-            (n, ns_per(dirs.len(), t))
+            (n, ns_per(dirs.len(), t[0]), ns_per(dirs.len(), t[1]))
         })
         .collect()
 }
@@ -482,12 +506,13 @@ pub fn section(opts: &Options) -> Result<Section, Box<dyn Error>> {
             .join(", ")
     )?;
 
-    html.push_str("<h3>Cap projection (zonal coefficients and their rotation to the axis)</h3><table><tr><th>bands</th><th>ns per cap</th><th>caps per second</th></tr>");
-    for (n, ns) in &caps {
+    html.push_str("<h3>Cap projection (zonal coefficients and their rotation to the axis)</h3><table><tr><th>bands</th><th>ns per cap, scalar</th><th>ns per cap, SIMD</th><th>SIMD / scalar</th><th>caps per second (SIMD)</th></tr>");
+    for (n, ns, simd) in &caps {
         writeln!(
             html,
-            "<tr><td>{n}</td><td>{ns:.1}</td><td>{:.2e}</td></tr>",
-            1e9 / ns
+            "<tr><td>{n}</td><td>{ns:.1}</td><td>{simd:.1}</td><td>{:.2}×</td><td>{:.2e}</td></tr>",
+            ns / simd,
+            1e9 / simd
         )?;
     }
     html.push_str("</table>");
@@ -583,7 +608,7 @@ pub fn section(opts: &Options) -> Result<Section, Box<dyn Error>> {
             "bands": r.bands, "zxzxz_ns": r.zxzxz_ns, "operator_build_ns": r.build_ns,
             "operator_apply_ns": r.apply_ns, "simd_operator_apply_ns": r.simd_apply_ns,
         })).collect::<Vec<_>>(),
-        "cap_ns": caps.iter().map(|(n, ns)| json!({"bands": n, "ns": ns})).collect::<Vec<_>>(),
+        "cap_ns": caps.iter().map(|(n, ns, simd)| json!({"bands": n, "ns": ns, "simd_ns": simd})).collect::<Vec<_>>(),
         "hvl_table1": t1.rows.iter().map(|(m, n, us, e)| json!({
             "hvls": m, "bands": n, "us_per_point": us, "error_lambert": e[0], "error_phong30": e[1],
         })).collect::<Vec<_>>(),

@@ -1,12 +1,12 @@
 //! SH coefficients of spherical caps, four caps per pass (mirrors
 //! `steradian_core::sh::cap::coefficients_into`): the basis at the four axes on `f64` lanes
 //! (the SH evaluation's twin, bit-identical), then each band scaled by the scalar kernel's
-//! own `f64` factors (`steradian_core::sh::cap::band_scales`, per lane) with one product
-//! and one rounding per coefficient on `wide::f64x4` lanes, so every lane is
+//! `f64` factors (`steradian_core::sh::cap::band_scales`, its recurrence on `wide::f64x4`
+//! lanes) with one product and one rounding per coefficient, so every lane is
 //! **bit-identical** to the scalar kernel, NaN included.
 
 use steradian_core::sh::MAX_BANDS;
-use steradian_core::sh::cap::{band_scales, check_coefficients};
+use steradian_core::sh::cap::{cap_trig, check_coefficients};
 use steradian_core::{Error, Vec3};
 use wide::f64x4;
 
@@ -25,8 +25,9 @@ pub fn coefficients_x4(
         check_coefficients(a, bands, out.len())?;
     }
     super::eval_x4(axes, bands, out)?;
-    let scales = scales(half_angles, bands);
-    for (l, k) in scales.iter().enumerate().take(bands) {
+    let mut k = [f64x4::ZERO; MAX_BANDS];
+    scales(half_angles, bands, &mut k);
+    for (l, k) in k.iter().enumerate().take(bands) {
         for v in &mut out[l * l..(l + 1) * (l + 1)] {
             *v = narrow(f64x4::new(v.map(f64::from)) * *k);
         }
@@ -62,31 +63,53 @@ pub fn coefficients_slices(
     }
     // The basis (its own column checks), then each group of four scaled in place.
     super::eval_slices(ax, ay, az, bands, out)?;
+    let mut k = [f64x4::ZERO; MAX_BANDS];
     for i in (0..len).step_by(4) {
         let live = (len - i).min(4);
         let angles: [f32; 4] =
-            core::array::from_fn(|k| if k < live { half_angle[i + k] } else { 0.0 });
-        let scales = scales(angles, bands);
-        for (l, k) in scales.iter().enumerate().take(bands) {
+            core::array::from_fn(|j| if j < live { half_angle[i + j] } else { 0.0 });
+        scales(angles, bands, &mut k);
+        for (l, k) in k.iter().enumerate().take(bands) {
             for c in l * l..(l + 1) * (l + 1) {
                 let at = c * len + i;
-                let lanes = &mut out[at..at + live];
-                let v: [f64; 4] =
-                    core::array::from_fn(|j| lanes.get(j).map_or(0.0, |x| f64::from(*x)));
-                lanes.copy_from_slice(&narrow(f64x4::new(v) * *k)[..live]);
+                if live == 4 {
+                    let v: [f32; 4] = [out[at], out[at + 1], out[at + 2], out[at + 3]];
+                    out[at..at + 4].copy_from_slice(&narrow(f64x4::new(v.map(f64::from)) * *k));
+                } else {
+                    let lanes = &mut out[at..at + live];
+                    let v: [f64; 4] =
+                        core::array::from_fn(|j| lanes.get(j).map_or(0.0, |x| f64::from(*x)));
+                    lanes.copy_from_slice(&narrow(f64x4::new(v) * *k)[..live]);
+                }
             }
         }
     }
     Ok(())
 }
 
-/// Each band's factor `√(4π/(2l+1))·L̃_l` of the four half-angles, lanes side by side.
-fn scales(half_angles: [f32; 4], bands: usize) -> [f64x4; MAX_BANDS] {
-    let mut k = [[0.0f64; 4]; MAX_BANDS];
-    for (lane, a) in half_angles.into_iter().enumerate() {
-        band_scales(a, bands, |l, s| k[l][lane] = s);
+/// Each band's factor `√(4π/(2l+1))·L̃_l` of the four half-angles into `k[..bands]`:
+/// `steradian_core::sh::cap::band_scales` on `f64` lanes (the same operations in the same
+/// order from each lane's `cap_trig`), bit-identical per lane.
+fn scales(half_angles: [f32; 4], bands: usize, k: &mut [f64x4; MAX_BANDS]) {
+    if bands == 0 {
+        return;
     }
-    k.map(f64x4::new)
+    let t = half_angles.map(cap_trig);
+    let lane = |i: usize| f64x4::new(t.map(|v| v[i]));
+    let (h2, s2, x) = (lane(0), lane(1), lane(2));
+    let pi = core::f64::consts::PI;
+    let sp = f64x4::splat;
+    k[0] = sp(4.0 * pi) * h2;
+    let (mut p_prev, mut p) = (sp(1.0), x);
+    let (mut dp_prev, mut dp) = (sp(0.0), sp(1.0));
+    for (l, k) in k.iter_mut().enumerate().take(bands).skip(1) {
+        let lf = l as f64;
+        *k = sp(2.0 * pi) * s2 * dp / sp(lf * (lf + 1.0));
+        let p_next = (sp(2.0 * lf + 1.0) * x * p - sp(lf) * p_prev) / sp(lf + 1.0);
+        let dp_next = dp_prev + sp(2.0 * lf + 1.0) * p;
+        (p_prev, p) = (p, p_next);
+        (dp_prev, dp) = (dp, dp_next);
+    }
 }
 
 /// The four lanes rounded to `f32`.
