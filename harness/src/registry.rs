@@ -370,7 +370,11 @@ pub const KERNELS: &[KernelSpec] = &[
         eval: Piece::At(handlers::sh_cap),
         scalar: "steradian_core::sh::cap::coefficients_into",
         simd: Piece::At("steradian_simd::sh::cap::coefficients_slices"),
-        wgsl: Piece::Without("not written yet (WGSL has no f64; see sh-eval)"),
+        wgsl: Piece::At(WgslTwin {
+            source: wgsl::SH_CAP,
+            tolerance: "steradian_core::wgsl::SH_CAP_TOL",
+            table: Some("f32"),
+        }),
         reference: Piece::At("steradian_reference::sh::cap_zonal"),
         bound: Piece::At(Bound {
             metric: "rel (zonal)",
@@ -387,7 +391,11 @@ pub const KERNELS: &[KernelSpec] = &[
         eval: Piece::At(handlers::sh_irradiance),
         scalar: "steradian_core::sh::irradiance::irradiance",
         simd: Piece::At("steradian_simd::sh::irradiance::irradiance_slices"),
-        wgsl: Piece::Without("not written yet (WGSL has no f64; see sh-eval)"),
+        wgsl: Piece::At(WgslTwin {
+            source: wgsl::SH_IRRADIANCE,
+            tolerance: "steradian_core::wgsl::SH_IRRADIANCE_TOL",
+            table: Some("f32"),
+        }),
         reference: Piece::At("steradian_reference::sh::irradiance"),
         bound: Piece::At(Bound {
             metric: "abs per unit of Σ|L|",

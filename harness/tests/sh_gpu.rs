@@ -63,3 +63,129 @@ fn sh_eval_gpu_matches_scalar() {
         "sh-eval on the GPU against the scalar kernel: {worst_by_bands:?}"
     ));
 }
+
+/// Axes of the GPU tests: random, the poles, the equator, non-unit, zero.
+fn axes(rng: &mut Rng, count: usize) -> Vec<[f32; 3]> {
+    let mut rows: Vec<[f32; 3]> = (0..count).map(|_| rng.sphere().map(|c| c as f32)).collect();
+    rows.extend([
+        [0.0, 0.0, 1.0],
+        [0.0, 0.0, -1.0],
+        [1.0, 0.0, 0.0],
+        [0.3, -0.4, 0.0],
+        [3e4, -2e4, 1e4],
+        [0.0, 0.0, 0.0],
+    ]);
+    rows
+}
+
+#[test]
+fn sh_cap_gpu_matches_scalar() {
+    let Some(mut g) = gpu() else { return };
+    let mut rng = Rng::new(0xca9);
+    // Half-angles from 1e-4 rad to π, the hemisphere; then bad ones (NaN on the GPU).
+    let angles = [
+        1e-4f32,
+        1e-3,
+        0.05,
+        0.5,
+        core::f32::consts::FRAC_PI_2,
+        2.2,
+        core::f32::consts::PI,
+    ];
+    let mut rows: Vec<[f32; 4]> = axes(&mut rng, 1500)
+        .into_iter()
+        .enumerate()
+        .map(|(k, d)| [d[0], d[1], d[2], angles[k % angles.len()]])
+        .collect();
+    let bad = [f32::NAN, -0.1, 3.2];
+    rows.extend(bad.map(|a| [0.0, 0.0, 1.0, a]));
+    let input = Columns::from_rows(&rows);
+    let mut worst_by_bands = Vec::new();
+    for bands in [1usize, 2, 3, 5, 9, 16] {
+        let nn = bands * bands;
+        let mut out = Columns::zeros(nn, rows.len());
+        let table = [bands as f32];
+        let custom = Custom {
+            label: "sh-cap",
+            source: wgsl::SH_CAP,
+            table: Some(&table),
+        };
+        g.run_custom(&custom, &input, &mut out)
+            .expect("SH cap kernel runs");
+        let n = rows.len();
+        let mut want = vec![0.0f32; nn];
+        let mut worst = 0.0f32;
+        for (k, r) in rows.iter().enumerate() {
+            let axis = Vec3::new(r[0], r[1], r[2]);
+            if sh::cap::coefficients_into(axis, r[3], bands, &mut want).is_err() {
+                for c in 0..nn {
+                    assert!(out.data[c * n + k].is_nan(), "bad half-angle {}", r[3]);
+                }
+                continue;
+            }
+            let omega = 4.0 * core::f32::consts::PI * (0.5 * r[3]).sin().powi(2);
+            for (c, w) in want.iter().enumerate() {
+                let got = out.data[c * n + k];
+                let err = (got - w).abs() / omega;
+                worst = worst.max(err);
+                assert!(
+                    err <= wgsl::SH_CAP_TOL,
+                    "{bands} bands, {r:?}, coefficient {c}: gpu {got} vs scalar {w} ({err:e} of the solid angle)"
+                );
+            }
+        }
+        worst_by_bands.push((bands, worst));
+    }
+    say(&format!(
+        "sh-cap on the GPU against the scalar kernel (per unit of the cap's solid angle): {worst_by_bands:?}"
+    ));
+}
+
+#[test]
+fn sh_irradiance_gpu_matches_scalar() {
+    let Some(mut g) = gpu() else { return };
+    let mut rng = Rng::new(0x1aad);
+    let rows = axes(&mut rng, 2000);
+    let input = Columns::from_rows(&rows);
+    let mut worst_by_bands = Vec::new();
+    for bands in [1usize, 2, 3, 5, 9, 16] {
+        let nn = bands * bands;
+        let radiance: Vec<f32> = (0..nn).map(|_| rng.range(-1.0, 2.0) as f32).collect();
+        let mut table = vec![bands as f32];
+        table.extend((0..bands).map(|l| sh::irradiance::clamped_cosine(l) as f32));
+        table.extend(&radiance);
+        let scale: f32 = (0..bands)
+            .map(|l| {
+                let a = sh::irradiance::clamped_cosine(l).abs() as f32;
+                a * radiance[l * l..(l + 1) * (l + 1)]
+                    .iter()
+                    .map(|v| v.abs())
+                    .sum::<f32>()
+            })
+            .sum();
+        let mut out = Columns::zeros(1, rows.len());
+        let custom = Custom {
+            label: "sh-irradiance",
+            source: wgsl::SH_IRRADIANCE,
+            table: Some(&table),
+        };
+        g.run_custom(&custom, &input, &mut out)
+            .expect("SH irradiance kernel runs");
+        let mut basis = vec![0.0f32; nn];
+        let mut worst = 0.0f32;
+        for (k, r) in rows.iter().enumerate() {
+            let want = sh::irradiance::irradiance(&radiance, Vec3::from(*r), &mut basis).unwrap();
+            let err = (out.data[k] - want).abs() / scale;
+            worst = worst.max(err);
+            assert!(
+                err <= wgsl::SH_IRRADIANCE_TOL,
+                "{bands} bands, {r:?}: gpu {} vs scalar {want} ({err:e} of Σ|A||L|)",
+                out.data[k]
+            );
+        }
+        worst_by_bands.push((bands, worst));
+    }
+    say(&format!(
+        "sh-irradiance on the GPU against the scalar kernel (per unit of Σ|A_l||L_lm|): {worst_by_bands:?}"
+    ));
+}

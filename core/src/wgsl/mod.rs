@@ -196,6 +196,7 @@ pub const CP_QUERY_TOL: f32 = 1.0e-5;
 /// of the same rationals on the GPU. Tolerance: [`SH_EVAL_TOL`].
 pub const SH_EVAL: &str = concat!(
     include_str!("batch.wgsl"),
+    include_str!("../sh/sh_basis.wgsl"),
     include_str!("../sh/sh_eval.wgsl")
 );
 /// Largest band count of [`SH_EVAL`].
@@ -205,6 +206,41 @@ pub const SH_EVAL_MAX_BANDS: usize = 16;
 /// Lavapipe: `1.7e-6` at 9 bands, `7.7e-6` at 16 (harness test `tests/sh_gpu.rs`, which
 /// prints them).
 pub const SH_EVAL_TOL: f32 = 1.0e-5;
+
+/// The SH coefficients of spherical caps (`sh::cap::coefficients_into`) in `f32`, for
+/// `bands ≤ 16`: the basis of [`SH_EVAL`] at the axis times each band's factor
+/// `2π·sin²a·P_l′(cos a)/(l(l+1))` (the scalar kernel's `band_scales`, in `f32`). Input
+/// columns `[x, y, z, a]`, output columns `l² + l + m`; binding 3 is one `f32`, the band
+/// count. A half-angle outside `[0, π]` or NaN gives NaN (the scalar kernel's error). Not in
+/// [`ALL`]. Tolerance: [`SH_CAP_TOL`].
+pub const SH_CAP: &str = concat!(
+    include_str!("batch.wgsl"),
+    include_str!("../sh/sh_basis.wgsl"),
+    include_str!("../sh/sh_cap.wgsl")
+);
+/// Absolute difference allowed between [`SH_CAP`] and `sh::cap::coefficients_into` per
+/// coefficient, in units of the cap's solid angle `4π·sin²(a/2)` (every coefficient of band
+/// `l` is at most `√((2l+1)/4π)` of it), for half-angles from `1e-4` to `π`. Lavapipe:
+/// `2.0e-6` at 9 bands, `6.0e-6` at 16, the basis's error (harness test `tests/sh_gpu.rs`,
+/// which prints them).
+pub const SH_CAP_TOL: f32 = 1.0e-5;
+
+/// The irradiance of one radiance vector at many normals (`sh::irradiance::irradiance`) in
+/// `f32`, for `bands ≤ 16`: the basis of [`SH_EVAL`] at the normal, dotted band by band
+/// with the radiance and weighted by the clamped-cosine factors. Input columns `[x, y, z]`,
+/// output one column; binding 3 is `[bands, A_0 … A_{bands−1}, L_0 … L_{bands²−1}]` (the
+/// factors of `sh::irradiance::clamped_cosine` rounded to `f32`, then the radiance). Not in
+/// [`ALL`]. Tolerance: [`SH_IRRADIANCE_TOL`].
+pub const SH_IRRADIANCE: &str = concat!(
+    include_str!("batch.wgsl"),
+    include_str!("../sh/sh_basis.wgsl"),
+    include_str!("../sh/sh_irradiance.wgsl")
+);
+/// Absolute difference allowed between [`SH_IRRADIANCE`] and `sh::irradiance::irradiance`,
+/// per unit of `Σ_l |A_l|·Σ_m |L_l^m|` (the basis's own tolerance [`SH_EVAL_TOL`] carried
+/// through the sum). Lavapipe: below `8e-8` through 16 bands (harness test
+/// `tests/sh_gpu.rs`, which prints them).
+pub const SH_IRRADIANCE_TOL: f32 = 1.0e-5;
 
 /// RSL shading of one point per invocation (`shade::shade` with an isotropic BRDF SAT and
 /// one VDT per point). Input columns `[tx, ty, tz, bx, by, bz, nx, ny, nz, wox, woy, woz,
@@ -318,10 +354,12 @@ pub const ALL: [(&str, &str); 5] = [
 
 /// The kernels outside [`ALL`], with a caller-supplied table at binding 3 (run them with
 /// the harness's custom kernels), as `(name, source, element type of the table)`.
-pub const CUSTOM: [(&str, &str, &str); 7] = [
+pub const CUSTOM: [(&str, &str, &str); 9] = [
     ("cp-query", CP_QUERY, "f32"),
     ("lobe-product", LOBE_PRODUCT, "f32"),
     ("sh-eval", SH_EVAL, "f32"),
+    ("sh-cap", SH_CAP, "f32"),
+    ("sh-irradiance", SH_IRRADIANCE, "f32"),
     ("sat-box", SAT_BOX, "u32"),
     ("vdt-box", VDT_QUERY, "f32"),
     ("shade", SHADE, "u32"),
