@@ -14,6 +14,7 @@
 //! | [`rsl::vdt`] | [`rsl::vdt::query`] | `query_slices` | bit-identical |
 //! | [`sh`] | [`sh::eval_x4`] (four directions, `f64` lanes as the scalar kernel) | `eval_slices` | bit-identical |
 //! | [`sh::cap`] | [`sh::cap::coefficients_x4`] (four caps, `f64` lanes) | `coefficients_slices` | bit-identical |
+//! | [`sh::hvl`] | [`sh::hvl::contributions_x4`] (four HVLs, one receiver) | `contributions` | bit-identical |
 //! | [`sh::irradiance`] | [`sh::irradiance::irradiance_x4`] (one radiance vector, four normals) | `irradiance_slices` | bit-identical |
 //! | [`cp`] | (one function at many directions) | [`cp::query_slices`] | bit-identical (gnomonic weights), within [`cp::AREA_TOL`] (area weights) |
 //! | [`rsl::shade`] | [`rsl::shade::shade_x8`], [`rsl::shade::shade_moments_x8`] | `shade_batch`, `shade_moments_batch` | within [`rsl::shade::REL_TOL`], [`rsl::shade::MOMENTS_REL_TOL`] |

@@ -362,3 +362,91 @@ fn irradiance_lanes_equal_the_scalar_kernel() {
         .is_ok()
     );
 }
+
+/// `contributions` of `hvls` to one receiver against the scalar `contribution`, bit for bit.
+fn check_hvls(hvls: &[sh::hvl::Hvl], emission: &[f32], rx: &sh::hvl::Receiver<'_>) {
+    let bands = sh::bands_of(rx.coeffs.len())
+        .expect("square")
+        .max(sh::bands_of(emission.len()).expect("square"));
+    let mut scratch4 = vec![[0.0f32; 4]; bands * bands];
+    let mut scratch = vec![0.0f32; bands * bands];
+    for horizon in [sh::hvl::Horizon::Smoothstep, sh::hvl::Horizon::Exact] {
+        let mut out = vec![0.0f32; hvls.len()];
+        steradian_simd::sh::hvl::contributions(
+            hvls,
+            emission,
+            rx,
+            horizon,
+            &mut scratch4,
+            &mut out,
+        )
+        .expect("valid shapes");
+        for (j, h) in hvls.iter().enumerate() {
+            let want =
+                sh::hvl::contribution(h, emission, rx, horizon, &mut scratch).expect("valid");
+            assert!(
+                same(out[j], want),
+                "HVL {j} {horizon:?}: {} vs {want}",
+                out[j]
+            );
+        }
+    }
+}
+
+#[test]
+fn hvl_lanes_equal_the_scalar_kernel() {
+    let mut rng = Rng(0x4f1);
+    for (n, ne) in [(1usize, 1usize), (3, 1), (5, 3), (9, 1), (14, 5)] {
+        let coeffs: Vec<f32> = (0..n * n).map(|_| rng.range(-0.5, 1.0)).collect();
+        let emission: Vec<f32> = (0..ne * ne).map(|_| rng.range(0.0, 0.5)).collect();
+        let normal = rng.dir();
+        let rx = sh::hvl::Receiver {
+            point: Vec3::new(0.1, -0.2, 0.3),
+            frame: sh::brdf::view_frame(normal, (normal + rng.dir() * 0.5).normalize())
+                .expect("frame"),
+            coeffs: &coeffs,
+        };
+        for len in LENGTHS {
+            // Around the receiver at distances 0.05–20, every orientation: some face away,
+            // some lie below its horizon, some are larger than their distance.
+            let hvls: Vec<sh::hvl::Hvl> = (0..len.min(200))
+                .map(|_| {
+                    let p = rx.point + rng.dir() * rng.log_range(0.05, 20.0);
+                    sh::hvl::Hvl::new(
+                        p,
+                        rng.dir(),
+                        rng.dir(),
+                        rng.log_range(0.01, 2.0),
+                        rng.range(0.0, 5.0),
+                    )
+                    .expect("valid HVL")
+                })
+                .collect();
+            check_hvls(&hvls, &emission, &rx);
+        }
+        // The HVL at the receiver itself, and one lit lane among settled ones in every position.
+        let at_point = sh::hvl::Hvl::new(rx.point, Vec3::Z, Vec3::Z, 0.1, 1.0).expect("valid");
+        let facing =
+            sh::hvl::Hvl::new(rx.point + normal, -normal, Vec3::Z, 0.3, 2.0).expect("valid");
+        for k in 0..5 {
+            let mut row = vec![at_point; 5];
+            row[k] = facing;
+            check_hvls(&row, &emission, &rx);
+        }
+    }
+    // Shapes: coefficient counts that are not squares, a short scratch, a short output.
+    let coeffs = [0.0f32; 9];
+    let rx = sh::hvl::Receiver {
+        point: Vec3::ZERO,
+        frame: sh::brdf::view_frame(Vec3::Z, Vec3::Z).expect("frame"),
+        coeffs: &coeffs,
+    };
+    let h = sh::hvl::Hvl::new(Vec3::Z, -Vec3::Z, Vec3::Z, 0.1, 1.0).expect("valid");
+    let hz = sh::hvl::Horizon::Smoothstep;
+    let mut s4 = vec![[0.0f32; 4]; 9];
+    let f = steradian_simd::sh::hvl::contributions;
+    assert!(f(&[h; 2], &[0.0; 2], &rx, hz, &mut s4, &mut [0.0; 2]).is_err());
+    assert!(f(&[h; 2], &[0.0; 1], &rx, hz, &mut s4[..4], &mut [0.0; 2]).is_err());
+    assert!(f(&[h; 2], &[0.0; 1], &rx, hz, &mut s4, &mut [0.0; 1]).is_err());
+    assert!(f(&[h; 2], &[0.0; 1], &rx, hz, &mut s4, &mut [0.0; 2]).is_ok());
+}

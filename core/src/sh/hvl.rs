@@ -229,6 +229,11 @@ pub struct Receiver<'a> {
 /// `emission` holds the HVL material's `F′` at the HVL's `θ_l` in its frame (any band
 /// count, 1 for an isotropic emitter); `scratch` at least `max(n², n_e²)` values.
 ///
+/// The geometry is [`prepare`]; then `P·e·G·s` (left to right) with
+/// `e = Σ F′_k·Y_k(−ω_j)` in the HVL's frame and `s = Σ F_k·C_k` of the cap `C` toward the
+/// HVL in the receiver's frame, each sum in index order from `+0` in `f32` (the SIMD twin,
+/// `steradian_simd::sh::hvl`, does the same operations on four HVLs at once).
+///
 /// Errors: coefficient counts that are not squares, a short `scratch`.
 pub fn contribution(
     hvl: &Hvl,
@@ -240,46 +245,90 @@ pub fn contribution(
     let n = crate::sh::bands_of(rx.coeffs.len())?;
     let ne = crate::sh::bands_of(emission.len())?;
     crate::sh::check_shape(n.max(ne), scratch.len())?;
-    let v = hvl.position - rx.point;
+    let (emit_dir, cap_axis, half_angle, power, g) =
+        match prepare(hvl, rx.point, &rx.frame, horizon) {
+            Prepared::Value(v) => return Ok(v),
+            Prepared::Lit {
+                emit_dir,
+                cap_axis,
+                half_angle,
+                power,
+                g,
+            } => (emit_dir, cap_axis, half_angle, power, g),
+        };
+    // Emission toward x: F′·Y(−ω_j) in the HVL's frame.
+    eval_into(emit_dir, ne, scratch)?;
+    let mut e = 0.0f32;
+    for (a, y) in emission.iter().zip(scratch.iter()) {
+        e += a * y;
+    }
+    // The cap in the receiver's frame, dotted with F.
+    cap::coefficients_into(cap_axis, half_angle, n, scratch)?;
+    let mut sum = 0.0f32;
+    for (f, c) in rx.coeffs.iter().zip(scratch.iter()) {
+        sum += f * c;
+    }
+    Ok(power * e * g * sum)
+}
+
+/// The geometry of one HVL seen from a receiver (eq. 20–22): either the contribution is
+/// settled without any SH (`Value`: NaN for a NaN distance, 0 for a coincident or infinitely
+/// far HVL, one facing away, or one wholly below the horizon), or it is `Lit` and
+/// [`contribution`] needs the emission direction `−ω_j` in the HVL's frame, the cap's axis
+/// `ω_j` in the receiver's frame, its half-angle `a = asin(min(r/d, 1))`, the power `P` and
+/// `G = cos θ_j·H/(π r²)`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Prepared {
+    /// The contribution, without SH.
+    Value(f32),
+    /// What the SH part needs.
+    Lit {
+        /// `−ω_j` in the HVL's frame.
+        emit_dir: Vec3,
+        /// `ω_j` in the receiver's frame.
+        cap_axis: Vec3,
+        /// The cap's half-angle (radians, in `[0, π/2]`).
+        half_angle: f32,
+        /// The HVL's power.
+        power: f32,
+        /// `G_j = cos θ_j·H/(π r²)`.
+        g: f32,
+    },
+}
+
+/// [`contribution`]'s geometry for the receiver at `point` with view frame `frame`
+/// ([`Prepared`]).
+pub fn prepare(hvl: &Hvl, point: Vec3, frame: &Frame, horizon: Horizon) -> Prepared {
+    let v = hvl.position - point;
     let d = math::sqrtf(v.dot(v));
     if d.is_nan() {
-        return Ok(f32::NAN);
+        return Prepared::Value(f32::NAN);
     }
     if d <= 0.0 || !d.is_finite() {
-        return Ok(0.0);
+        return Prepared::Value(0.0);
     }
     let w = v / d;
     let cos_j = -w.dot(hvl.frame.normal());
     if cos_j <= 0.0 {
-        return Ok(0.0);
+        return Prepared::Value(0.0);
     }
     let sin_a = (hvl.radius / d).min(1.0);
     let a = math::asinf(sin_a);
-    let cos_x = w.dot(rx.frame.normal());
+    let cos_x = w.dot(frame.normal());
     let h = match horizon {
         Horizon::Smoothstep => horizon_smoothstep(cos_x, a),
         Horizon::Exact => horizon_exact(cos_x, a),
     };
     if h == 0.0 {
-        return Ok(0.0);
+        return Prepared::Value(0.0);
     }
-    // Emission toward x: F′·Y(−ω_j) in the HVL's frame.
-    eval_into(hvl.frame.to_local(-w), ne, scratch)?;
-    let e: f32 = emission
-        .iter()
-        .zip(scratch.iter())
-        .map(|(a, b)| a * b)
-        .sum();
-    // The cap in the receiver's frame, dotted with F.
-    cap::coefficients_into(rx.frame.to_local(w), a, n, scratch)?;
-    let s: f32 = rx
-        .coeffs
-        .iter()
-        .zip(scratch.iter())
-        .map(|(a, b)| a * b)
-        .sum();
-    let g = cos_j * h / (core::f32::consts::PI * hvl.radius * hvl.radius);
-    Ok(hvl.power * e * g * s)
+    Prepared::Lit {
+        emit_dir: hvl.frame.to_local(-w),
+        cap_axis: frame.to_local(w),
+        half_angle: a,
+        power: hvl.power,
+        g: cos_j * h / (core::f32::consts::PI * hvl.radius * hvl.radius),
+    }
 }
 
 /// The emission coefficients of a Lambertian HVL of albedo `albedo`: the constant

@@ -12,7 +12,7 @@ use std::hint::black_box;
 
 use serde_json::json;
 use steradian_core::Vec3;
-use steradian_core::sh::{self, rotate, window::Window};
+use steradian_core::sh::{self, brdf, hvl, rotate, window::Window};
 
 use super::Options;
 use super::section::Section;
@@ -278,6 +278,69 @@ fn table1(opts: &Options) -> Table1 {
     Table1 { rows }
 }
 
+/// Per band count (3, 5, 9): ns per HVL contribution, scalar and SIMD (four HVLs per pass),
+/// taking turns, the 400 HVLs of Table 1's scene at its first receiver with the Phong 30
+/// table's `F`.
+fn hvl_rows(opts: &Options) -> Vec<(usize, f64, f64)> {
+    let scene = study::hvl_scene(20);
+    let mats = study::materials();
+    let em = hvl::lambert_emission(0.8);
+    let v3 = |a: [f64; 3]| Vec3::new(a[0] as f32, a[1] as f32, a[2] as f32);
+    let p = scene.points[0];
+    let wo = (v3(scene.eye) - v3(p)).normalize();
+    let frame = brdf::view_frame(v3(scene.normal), wo).expect("unit normal");
+    let theta = frame.to_local(wo).z.clamp(-1.0, 1.0).acos();
+    let reps = opts.scaled(4096).max(64).div_ceil(scene.hvls.len()).max(1);
+    [3usize, 5, 9]
+        .iter()
+        .map(|&n| {
+            let n = n.min(mats[1].table.bands());
+            let mut coeffs = vec![0.0f32; n * n];
+            mats[1]
+                .table
+                .lookup_into(brdf::Part::WithCosine, theta, n, &mut coeffs)
+                .expect("bands within the table");
+            let rx = hvl::Receiver {
+                point: v3(p),
+                frame,
+                coeffs: &coeffs,
+            };
+            let mut scratch = vec![0.0f32; n * n];
+            let mut scratch4 = vec![[0.0f32; 4]; n * n];
+            let mut out = vec![0.0f32; scene.hvls.len()];
+            let t = median_times_in_turns(opts.repeats.min(5), 2, |k| {
+                for _ in 0..reps {
+                    if k == 0 {
+                        for (h, o) in scene.hvls.iter().zip(out.iter_mut()) {
+                            *o = hvl::contribution(
+                                h,
+                                &em,
+                                &rx,
+                                hvl::Horizon::Smoothstep,
+                                &mut scratch,
+                            )
+                            .expect("shapes");
+                        }
+                    } else {
+                        steradian_simd::sh::hvl::contributions(
+                            &scene.hvls,
+                            &em,
+                            &rx,
+                            hvl::Horizon::Smoothstep,
+                            &mut scratch4,
+                            &mut out,
+                        )
+                        .expect("shapes");
+                    }
+                    black_box(&out);
+                }
+            });
+            let count = reps * scene.hvls.len();
+            (n, ns_per(count, t[0]), ns_per(count, t[1]))
+        })
+        .collect()
+}
+
 /// Per built-in material: (name, bands, samples, bytes, errors at [3, 5, 7, 9, 11, 14] for
 /// no window, Hanning, Cesàro).
 type BrdfRow = (&'static str, usize, usize, usize, [[f64; 6]; 3]);
@@ -408,6 +471,7 @@ pub fn section(opts: &Options) -> Result<Section, Box<dyn Error>> {
     let rot = rotate_rows(opts);
     let caps = cap_rows(opts);
     let t1 = table1(opts);
+    let hvl_ns = hvl_rows(opts);
     let brdf = brdf_rows();
     let windows = window_rows();
     let (env, files) = env_rows(opts)?;
@@ -542,6 +606,27 @@ pub fn section(opts: &Options) -> Result<Section, Box<dyn Error>> {
             e[0], e[1]
         )?;
     }
+    html.push_str(
+        "<h3>HVL contributions per second</h3><p>One contribution (eq. 19–22: the cap toward \
+         the HVL projected, rotated and dotted with the receiver's F, the emission F′·Y(−ω)), \
+         the 400 HVLs of the M = 400 scene at one Phong 30 receiver, smoothstep H; scalar \
+         and SIMD (four HVLs per pass, bit-identical) taking turns. No wgpu twin yet.</p>\
+         <table><tr><th>bands</th><th>ns, scalar</th><th>ns, SIMD</th><th>SIMD / scalar</th><th>contributions per second (SIMD)</th></tr>",
+    );
+    for (n, sc, si) in &hvl_ns {
+        writeln!(
+            html,
+            "<tr><td>{n}</td><td>{sc:.1}</td><td>{si:.1}</td><td>{:.2}×</td><td>{:.2e}</td></tr>",
+            sc / si,
+            1e9 / si
+        )?;
+        writeln!(
+            summary,
+            "HVL contribution at {n} bands: scalar {sc:.1} ns, SIMD {si:.1} ns ({:.2}×)",
+            sc / si
+        )?;
+    }
+    html.push_str("</table>");
 
     html.push_str("<h3>BRDF SH tables</h3><p>Relative L2 truncation error of F at θₒ = 45° (Parseval on 16 bands of coefficients), without a window / Hanning / Cesàro, per band limit.</p><table><tr><th>material</th><th>table (bands × views, bytes)</th><th>window</th><th>3</th><th>5</th><th>7</th><th>9</th><th>11</th><th>14</th></tr>");
     for (name, bands, samples, bytes, errs) in &brdf {
@@ -609,6 +694,7 @@ pub fn section(opts: &Options) -> Result<Section, Box<dyn Error>> {
             "operator_apply_ns": r.apply_ns, "simd_operator_apply_ns": r.simd_apply_ns,
         })).collect::<Vec<_>>(),
         "cap_ns": caps.iter().map(|(n, ns, simd)| json!({"bands": n, "ns": ns, "simd_ns": simd})).collect::<Vec<_>>(),
+        "hvl_ns": hvl_ns.iter().map(|(n, sc, si)| json!({"bands": n, "scalar_ns": sc, "simd_ns": si})).collect::<Vec<_>>(),
         "hvl_table1": t1.rows.iter().map(|(m, n, us, e)| json!({
             "hvls": m, "bands": n, "us_per_point": us, "error_lambert": e[0], "error_phong30": e[1],
         })).collect::<Vec<_>>(),

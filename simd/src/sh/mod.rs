@@ -14,6 +14,7 @@
 //! Those of `steradian_core::sh` (the HVL paper, eq. 7–8).
 
 pub mod cap;
+pub mod hvl;
 pub mod irradiance;
 pub mod rotate;
 
