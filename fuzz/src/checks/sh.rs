@@ -4,7 +4,9 @@
 //! finite direction and any half-angle in `[0, π]` (an error outside, never a panic); the
 //! irradiance of finite coefficients at a finite normal is finite; a rotation that passes
 //! validation (nine arbitrary entries, or an arbitrary axis and angle) preserves every
-//! band's norm on both paths (ZXZXZ and the built operator), which agree.
+//! band's norm on both paths (ZXZXZ and the built operator), which agree. The SIMD twins of
+//! the cap coefficients and of the irradiance equal their scalar kernels bit for bit on the
+//! same arbitrary bits.
 
 use steradian_core::sh::rotate::{Operator, Rotation, Rotator, rotate_rel_error};
 use steradian_core::{Vec3, sh};
@@ -70,6 +72,52 @@ pub fn check(data: &[u8]) {
     let z: Vec<f32> = dirs.iter().map(|d| d.z).collect();
     let n = bands * bands;
     let mut cols = vec![0.0f32; n * 4];
+    steradian_simd::sh::eval_slices(&x, &y, &z, bands, &mut cols).expect("valid shapes");
+    // The cap twin: four caps of the same arbitrary half-angle, bit for bit or an error
+    // exactly where the scalar kernel errs.
+    let a = f32_at(rest, 48);
+    let angles = [a; 4];
+    let simd_caps =
+        steradian_simd::sh::cap::coefficients_slices(&x, &y, &z, &angles, bands, &mut cols);
+    let mut c = vec![0.0f32; n];
+    for (i, d) in dirs.iter().enumerate() {
+        let scalar = sh::cap::coefficients_into(*d, a, bands, &mut c);
+        assert_eq!(
+            scalar.is_ok(),
+            simd_caps.is_ok(),
+            "cap {a}: the twins disagree on validity"
+        );
+        if scalar.is_ok() {
+            for k in 0..n {
+                let (s, v) = (cols[k * 4 + i], c[k]);
+                assert!(
+                    s.to_bits() == v.to_bits() || (s.is_nan() && v.is_nan()),
+                    "cap {d} {a} k {k}: {s} vs {v}"
+                );
+            }
+        }
+    }
+    // The irradiance twin: arbitrary radiance bits at the four normals.
+    let radiance: Vec<f32> = (0..n).map(|k| f32_at(rest, 4 * k)).collect();
+    let mut scratch4 = vec![[0.0f32; 4]; n];
+    let mut e4 = [0.0f32; 4];
+    steradian_simd::sh::irradiance::irradiance_slices(
+        &radiance,
+        &x,
+        &y,
+        &z,
+        &mut scratch4,
+        &mut e4,
+    )
+    .expect("valid shapes");
+    for (i, d) in dirs.iter().enumerate() {
+        let e = sh::irradiance::irradiance(&radiance, *d, &mut c).expect("square length");
+        assert!(
+            e.to_bits() == e4[i].to_bits() || (e.is_nan() && e4[i].is_nan()),
+            "irradiance {d}: {} vs {e}",
+            e4[i]
+        );
+    }
     steradian_simd::sh::eval_slices(&x, &y, &z, bands, &mut cols).expect("valid shapes");
     let mut one = vec![0.0f32; n];
     for (i, d) in dirs.iter().enumerate() {
