@@ -415,7 +415,11 @@ pub const KERNELS: &[KernelSpec] = &[
             "the ZXZXZ path has none; the built operator's twin (8 vectors per pass, \
              bit-identical) is steradian_simd::sh::rotate::apply_operator_slices",
         ),
-        wgsl: Piece::Without("not written yet"),
+        wgsl: Piece::At(WgslTwin {
+            source: wgsl::SH_ROTATE,
+            tolerance: "steradian_core::wgsl::SH_ROTATE_TOL",
+            table: Some("f32"),
+        }),
         reference: Piece::At("steradian_reference::sh::rotate"),
         bound: Piece::At(Bound {
             metric: "‖error‖/‖c‖",

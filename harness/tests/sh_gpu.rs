@@ -189,3 +189,59 @@ fn sh_irradiance_gpu_matches_scalar() {
         "sh-irradiance on the GPU against the scalar kernel (per unit of Σ|A_l||L_lm|): {worst_by_bands:?}"
     ));
 }
+
+#[test]
+fn sh_rotate_gpu_matches_scalar() {
+    let Some(mut g) = gpu() else { return };
+    let mut rng = Rng::new(0x707);
+    let rot = sh::rotate::Rotation::from_axis_angle(Vec3::new(0.3, -0.5, 0.8), 1.1).unwrap();
+    let mut worst_by_bands = Vec::new();
+    for bands in [1usize, 2, 3, 5, 10, 30] {
+        let nn = bands * bands;
+        let op = sh::rotate::Operator::new(&rot, bands).unwrap();
+        let count = 300;
+        let vectors: Vec<Vec<f32>> = (0..count)
+            .map(|_| (0..nn).map(|_| rng.range(-2.0, 2.0) as f32).collect())
+            .collect();
+        let mut input = Columns::zeros(nn, count);
+        for (i, v) in vectors.iter().enumerate() {
+            for (k, x) in v.iter().enumerate() {
+                input.data[k * count + i] = *x;
+            }
+        }
+        let mut table = vec![bands as f32];
+        table.extend_from_slice(op.blocks());
+        let mut out = Columns::zeros(nn, count);
+        let custom = Custom {
+            label: "sh-rotate",
+            source: wgsl::SH_ROTATE,
+            table: Some(&table),
+        };
+        g.run_custom(&custom, &input, &mut out)
+            .expect("SH rotation kernel runs");
+        let mut want = vec![0.0f32; nn];
+        let mut worst = 0.0f32;
+        for (i, v) in vectors.iter().enumerate() {
+            op.apply(v, &mut want).unwrap();
+            for l in 0..bands {
+                let band = l * l..(l + 1) * (l + 1);
+                let norm = v[band.clone()].iter().map(|x| x * x).sum::<f32>().sqrt();
+                for k in band {
+                    let err =
+                        (out.data[k * count + i] - want[k]).abs() / norm.max(f32::MIN_POSITIVE);
+                    worst = worst.max(err);
+                    assert!(
+                        err <= wgsl::SH_ROTATE_TOL,
+                        "{bands} bands, vector {i}, coefficient {k}: gpu {} vs scalar {} ({err:e} of the band's norm)",
+                        out.data[k * count + i],
+                        want[k]
+                    );
+                }
+            }
+        }
+        worst_by_bands.push((bands, worst));
+    }
+    say(&format!(
+        "sh-rotate (built operator) on the GPU against the scalar kernel (per unit of the band's norm): {worst_by_bands:?}"
+    ));
+}

@@ -225,6 +225,20 @@ pub const SH_CAP: &str = concat!(
 /// which prints them).
 pub const SH_CAP_TOL: f32 = 1.0e-5;
 
+/// The built SH rotation operator (`sh::rotate::apply_operator`, the many-vectors path of
+/// `sh-rotate`) applied to one coefficient vector per invocation, in `f32` as on the CPU.
+/// Input and output: `bands²` columns; binding 3 is `[bands, blocks…]` (the blocks of
+/// `sh::rotate::Operator::blocks`). Not in [`ALL`]. Tolerance: [`SH_ROTATE_TOL`].
+pub const SH_ROTATE: &str = concat!(
+    include_str!("batch.wgsl"),
+    include_str!("../sh/sh_rotate.wgsl")
+);
+/// Absolute difference allowed between [`SH_ROTATE`] and `sh::rotate::apply_operator` per
+/// coefficient, in units of the norm of the input's band (a GPU may fuse the sums'
+/// multiply-adds). Lavapipe: bit-identical through 30 bands (harness test
+/// `tests/sh_gpu.rs`, which prints the largest difference).
+pub const SH_ROTATE_TOL: f32 = 1.0e-6;
+
 /// The irradiance of one radiance vector at many normals (`sh::irradiance::irradiance`) in
 /// `f32`, for `bands ≤ 16`: the basis of [`SH_EVAL`] at the normal, dotted band by band
 /// with the radiance and weighted by the clamped-cosine factors. Input columns `[x, y, z]`,
@@ -354,12 +368,13 @@ pub const ALL: [(&str, &str); 5] = [
 
 /// The kernels outside [`ALL`], with a caller-supplied table at binding 3 (run them with
 /// the harness's custom kernels), as `(name, source, element type of the table)`.
-pub const CUSTOM: [(&str, &str, &str); 9] = [
+pub const CUSTOM: [(&str, &str, &str); 10] = [
     ("cp-query", CP_QUERY, "f32"),
     ("lobe-product", LOBE_PRODUCT, "f32"),
     ("sh-eval", SH_EVAL, "f32"),
     ("sh-cap", SH_CAP, "f32"),
     ("sh-irradiance", SH_IRRADIANCE, "f32"),
+    ("sh-rotate", SH_ROTATE, "f32"),
     ("sat-box", SAT_BOX, "u32"),
     ("vdt-box", VDT_QUERY, "f32"),
     ("shade", SHADE, "u32"),
