@@ -245,3 +245,102 @@ fn sh_rotate_gpu_matches_scalar() {
         "sh-rotate (built operator) on the GPU against the scalar kernel (per unit of the band's norm): {worst_by_bands:?}"
     ));
 }
+
+#[test]
+fn sh_hvl_gpu_matches_scalar() {
+    use sh::hvl::{Horizon, Hvl, Receiver, contribution};
+    let Some(mut g) = gpu() else { return };
+    let mut rng = Rng::new(0x4f1);
+    let v = |a: [f64; 3]| Vec3::new(a[0] as f32, a[1] as f32, a[2] as f32);
+    let mut worst_by_bands = Vec::new();
+    for (n, ne) in [(1usize, 1usize), (3, 1), (5, 3), (9, 1), (14, 5)] {
+        let coeffs: Vec<f32> = (0..n * n).map(|_| rng.range(-0.5, 1.0) as f32).collect();
+        let emission: Vec<f32> = (0..ne * ne).map(|_| rng.range(0.0, 0.5) as f32).collect();
+        let normal = v(rng.sphere());
+        let wo = (normal + v(rng.sphere()) * 0.5).normalize();
+        let rx = Receiver {
+            point: Vec3::new(0.1, -0.2, 0.3),
+            frame: sh::brdf::view_frame(normal, wo).unwrap(),
+            coeffs: &coeffs,
+        };
+        let hvls: Vec<Hvl> = (0..2000)
+            .map(|_| {
+                let d = rng.range(0.05f64.ln(), 20f64.ln()).exp() as f32;
+                let p = rx.point + v(rng.sphere()) * d;
+                let r = rng.range(0.01f64.ln(), 2f64.ln()).exp() as f32;
+                Hvl::new(
+                    p,
+                    v(rng.sphere()),
+                    v(rng.sphere()),
+                    r,
+                    rng.range(0.0, 5.0) as f32,
+                )
+                .unwrap()
+            })
+            .collect();
+        let rows: Vec<[f32; 14]> = hvls
+            .iter()
+            .map(|h| {
+                let f = h.frame();
+                let (t, b, nn) = (f.to_world(Vec3::X), f.to_world(Vec3::Y), f.normal());
+                let p = h.position();
+                [
+                    p.x,
+                    p.y,
+                    p.z,
+                    t.x,
+                    t.y,
+                    t.z,
+                    b.x,
+                    b.y,
+                    b.z,
+                    nn.x,
+                    nn.y,
+                    nn.z,
+                    h.radius(),
+                    h.power(),
+                ]
+            })
+            .collect();
+        let (t, b, nn) = (
+            rx.frame.to_world(Vec3::X),
+            rx.frame.to_world(Vec3::Y),
+            rx.frame.normal(),
+        );
+        let mut table = vec![n as f32, ne as f32];
+        for q in [rx.point, t, b, nn] {
+            table.extend([q.x, q.y, q.z]);
+        }
+        table.extend(&coeffs);
+        table.extend(&emission);
+        let input = Columns::from_rows(&rows);
+        let mut out = Columns::zeros(1, rows.len());
+        let custom = Custom {
+            label: "sh-hvl",
+            source: wgsl::SH_HVL,
+            table: Some(&table),
+        };
+        g.run_custom(&custom, &input, &mut out)
+            .expect("HVL kernel runs");
+        let mut scratch = vec![0.0f32; n.max(ne) * n.max(ne)];
+        let want: Vec<f32> = hvls
+            .iter()
+            .map(|h| contribution(h, &emission, &rx, Horizon::Smoothstep, &mut scratch).unwrap())
+            .collect();
+        let scale = want.iter().fold(0.0f32, |m, w| m.max(w.abs()));
+        let mut worst = 0.0f32;
+        for (k, w) in want.iter().enumerate() {
+            let err = (out.data[k] - w).abs() / scale;
+            worst = worst.max(err);
+            assert!(
+                err <= wgsl::SH_HVL_TOL,
+                "{n}/{ne} bands, HVL {k}: gpu {} vs scalar {w} ({err:e} of the largest)",
+                out.data[k]
+            );
+        }
+        worst_by_bands.push((n, ne, worst));
+    }
+    say(&format!(
+        "sh-hvl on the GPU against the scalar kernel (per unit of the largest contribution): {worst_by_bands:?}"
+    ));
+}

@@ -154,6 +154,10 @@ impl Hvl {
     pub fn radius(&self) -> f32 {
         self.radius
     }
+    /// The power (W, per channel).
+    pub fn power(&self) -> f32 {
+        self.power
+    }
     /// The angle `θ_l` between the normal and the light: where to look up the emission's
     /// `F′` table.
     pub fn theta_l(&self) -> f32 {

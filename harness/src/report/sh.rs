@@ -278,10 +278,14 @@ fn table1(opts: &Options) -> Table1 {
     Table1 { rows }
 }
 
+/// One row of the HVL speed table: bands, ns per contribution scalar, SIMD, wgpu (upload
+/// and read-back included; `None` without an adapter).
+type HvlRow = (usize, f64, f64, Option<f64>);
+
 /// Per band count (3, 5, 9): ns per HVL contribution, scalar and SIMD (four HVLs per pass),
-/// taking turns, the 400 HVLs of Table 1's scene at its first receiver with the Phong 30
+/// taking turns, and on wgpu (`wgsl::SH_HVL`, one contribution per invocation), the 400 HVLs of Table 1's scene at its first receiver with the Phong 30
 /// table's `F`.
-fn hvl_rows(opts: &Options) -> Vec<(usize, f64, f64)> {
+fn hvl_rows(opts: &Options, gpu: &mut Option<Gpu>) -> Vec<HvlRow> {
     let scene = study::hvl_scene(20);
     let mats = study::materials();
     let em = hvl::lambert_emission(0.8);
@@ -336,7 +340,57 @@ fn hvl_rows(opts: &Options) -> Vec<(usize, f64, f64)> {
                 }
             });
             let count = reps * scene.hvls.len();
-            (n, ns_per(count, t[0]), ns_per(count, t[1]))
+            let gpu_ns = gpu.as_mut().map(|g| {
+                let rows: Vec<[f32; 14]> = scene
+                    .hvls
+                    .iter()
+                    .map(|h| {
+                        let f = h.frame();
+                        let (t, b, nn) = (f.to_world(Vec3::X), f.to_world(Vec3::Y), f.normal());
+                        let p = h.position();
+                        [
+                            p.x,
+                            p.y,
+                            p.z,
+                            t.x,
+                            t.y,
+                            t.z,
+                            b.x,
+                            b.y,
+                            b.z,
+                            nn.x,
+                            nn.y,
+                            nn.z,
+                            h.radius(),
+                            h.power(),
+                        ]
+                    })
+                    .collect();
+                let (t, b, nn) = (
+                    frame.to_world(Vec3::X),
+                    frame.to_world(Vec3::Y),
+                    frame.normal(),
+                );
+                let mut table = vec![n as f32, 1.0];
+                for q in [rx.point, t, b, nn] {
+                    table.extend([q.x, q.y, q.z]);
+                }
+                table.extend(&coeffs);
+                table.extend(&em);
+                let input = Columns::from_rows(&rows);
+                let mut out = Columns::zeros(1, rows.len());
+                let custom = Custom {
+                    label: "sh-hvl",
+                    source: wgsl::SH_HVL,
+                    table: Some(&table),
+                };
+                let t = median_time(opts.repeats.min(5), || {
+                    g.run_custom(&custom, &input, &mut out)
+                        .expect("HVL kernel runs");
+                });
+                ns_per(rows.len(), t)
+            });
+            (n, ns_per(count, t[0]), ns_per(count, t[1]), gpu_ns)
         })
         .collect()
 }
@@ -467,11 +521,11 @@ pub fn section(opts: &Options) -> Result<Section, Box<dyn Error>> {
     let rate = study::mul_add_rate();
     let (mut gpu, gpu_note) = gpu::if_requested(opts.gpu);
     let eval = eval_rows(opts, &mut gpu);
+    let hvl_ns = hvl_rows(opts, &mut gpu);
     drop(gpu);
     let rot = rotate_rows(opts);
     let caps = cap_rows(opts);
     let t1 = table1(opts);
-    let hvl_ns = hvl_rows(opts);
     let brdf = brdf_rows();
     let windows = window_rows();
     let (env, files) = env_rows(opts)?;
@@ -610,20 +664,23 @@ pub fn section(opts: &Options) -> Result<Section, Box<dyn Error>> {
         "<h3>HVL contributions per second</h3><p>One contribution (eq. 19–22: the cap toward \
          the HVL projected, rotated and dotted with the receiver's F, the emission F′·Y(−ω)), \
          the 400 HVLs of the M = 400 scene at one Phong 30 receiver, smoothstep H; scalar \
-         and SIMD (four HVLs per pass, bit-identical) taking turns. No wgpu twin yet.</p>\
-         <table><tr><th>bands</th><th>ns, scalar</th><th>ns, SIMD</th><th>SIMD / scalar</th><th>contributions per second (SIMD)</th></tr>",
+         and SIMD (four HVLs per pass, bit-identical) taking turns; wgpu (wgsl::SH_HVL, one \
+         contribution per invocation, f32, upload and read-back included).</p>\
+         <table><tr><th>bands</th><th>ns, scalar</th><th>ns, SIMD</th><th>ns, wgpu</th><th>SIMD / scalar</th><th>contributions per second (SIMD)</th></tr>",
     );
-    for (n, sc, si) in &hvl_ns {
+    for (n, sc, si, gp) in &hvl_ns {
         writeln!(
             html,
-            "<tr><td>{n}</td><td>{sc:.1}</td><td>{si:.1}</td><td>{:.2}×</td><td>{:.2e}</td></tr>",
+            "<tr><td>{n}</td><td>{sc:.1}</td><td>{si:.1}</td><td>{}</td><td>{:.2}×</td><td>{:.2e}</td></tr>",
+            gp.map_or("—".to_string(), |g| format!("{g:.1}")),
             sc / si,
             1e9 / si
         )?;
         writeln!(
             summary,
-            "HVL contribution at {n} bands: scalar {sc:.1} ns, SIMD {si:.1} ns ({:.2}×)",
-            sc / si
+            "HVL contribution at {n} bands: scalar {sc:.1} ns, SIMD {si:.1} ns ({:.2}×), wgpu {}",
+            sc / si,
+            gp.map_or("—".to_string(), |g| format!("{g:.1} ns"))
         )?;
     }
     html.push_str("</table>");
@@ -694,7 +751,7 @@ pub fn section(opts: &Options) -> Result<Section, Box<dyn Error>> {
             "operator_apply_ns": r.apply_ns, "simd_operator_apply_ns": r.simd_apply_ns,
         })).collect::<Vec<_>>(),
         "cap_ns": caps.iter().map(|(n, ns, simd)| json!({"bands": n, "ns": ns, "simd_ns": simd})).collect::<Vec<_>>(),
-        "hvl_ns": hvl_ns.iter().map(|(n, sc, si)| json!({"bands": n, "scalar_ns": sc, "simd_ns": si})).collect::<Vec<_>>(),
+        "hvl_ns": hvl_ns.iter().map(|(n, sc, si, gp)| json!({"bands": n, "scalar_ns": sc, "simd_ns": si, "wgpu_ns": gp})).collect::<Vec<_>>(),
         "hvl_table1": t1.rows.iter().map(|(m, n, us, e)| json!({
             "hvls": m, "bands": n, "us_per_point": us, "error_lambert": e[0], "error_phong30": e[1],
         })).collect::<Vec<_>>(),

@@ -1,0 +1,109 @@
+// steradian: one HVL's contribution to one receiver per invocation (mirrors
+// `sh::hvl::contribution` with the smoothstep horizon, in f32): the geometry of
+// `sh::hvl::prepare`, the emission F′·Y(−ω_j) in the HVL's frame and the cap toward the HVL
+// in the receiver's frame dotted with its F (the basis of `sh_basis`, the cap's band factors
+// 2π·sin²a·P_l′(cos a)/(l(l+1)) as `sh_cap.wgsl`), then P·e·G·s.
+// Input columns (one row per HVL): [px, py, pz, tx, ty, tz, bx, by, bz, nx, ny, nz, r, P]
+// (centre, the HVL frame's tangent, bitangent and normal, radius, power). Output: one
+// column. Table (binding 3): [n, ne, x, y, z, rtx, rty, rtz, rbx, rby, rbz, rnx, rny, rnz,
+// F_0 … F_{n²−1}, F′_0 … F′_{ne²−1}] (bands n, ne ≤ 16; the receiver's point and frame).
+
+@group(0) @binding(3) var<storage, read> table: array<f32>;
+
+fn col(k: u32, i: u32) -> f32 {
+    return input[k * params.n + i];
+}
+
+// asin through atan2 with √((1 − x)(1 + x)), accurate near |x| = 1 (where 1 − x² loses
+// the digits the horizon term and the cap's half-angle need).
+fn asin_acc(x: f32) -> f32 {
+    return atan2(x, sqrt((1.0 - x) * (1.0 + x)));
+}
+
+fn v3(at: u32) -> vec3<f32> {
+    return vec3<f32>(table[at], table[at + 1u], table[at + 2u]);
+}
+
+@compute @workgroup_size(64)
+fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
+    let i = batch_row(gid);
+    if (i >= params.n) {
+        return;
+    }
+    let n = min(u32(table[0]), SH_MAX_BANDS);
+    let ne = min(u32(table[1]), SH_MAX_BANDS);
+    let x = v3(2u);
+    let rt = v3(5u);
+    let rb = v3(8u);
+    let rn = v3(11u);
+    let coeffs = 14u;
+    let emission = coeffs + n * n;
+    let p = vec3<f32>(col(0u, i), col(1u, i), col(2u, i));
+    let ht = vec3<f32>(col(3u, i), col(4u, i), col(5u, i));
+    let hb = vec3<f32>(col(6u, i), col(7u, i), col(8u, i));
+    let hn = vec3<f32>(col(9u, i), col(10u, i), col(11u, i));
+    let radius = col(12u, i);
+    let power = col(13u, i);
+    let v = p - x;
+    let d = sqrt(dot(v, v));
+    // NaN fails every comparison: a NaN distance is NaN, as on the CPU.
+    if (!(d == d)) {
+        output[i] = bitcast<f32>(0x7fc00000u);
+        return;
+    }
+    if (d <= 0.0 || d > 3.4028235e38) {
+        output[i] = 0.0;
+        return;
+    }
+    let w = v / d;
+    let cos_j = -dot(w, hn);
+    if (cos_j <= 0.0) {
+        output[i] = 0.0;
+        return;
+    }
+    let a = asin_acc(min(radius / d, 1.0));
+    let c = clamp(dot(w, rn), -1.0, 1.0);
+    let t = clamp((a + asin_acc(c)) / (2.0 * a), 0.0, 1.0);
+    let h = t * t * (3.0 - 2.0 * t);
+    if (h == 0.0) {
+        output[i] = 0.0;
+        return;
+    }
+    // Emission toward x: F′·Y(−ω_j) in the HVL's frame.
+    sh_basis(vec3<f32>(dot(-w, ht), dot(-w, hb), dot(-w, hn)), ne);
+    var e = 0.0;
+    for (var k = 0u; k < ne * ne; k++) {
+        e = e + table[emission + k] * ybuf[k];
+    }
+    // The cap toward the HVL in the receiver's frame, dotted with F.
+    sh_basis(vec3<f32>(dot(w, rt), dot(w, rb), dot(w, rn)), n);
+    let sh = sin(0.5 * a);
+    let ch = cos(0.5 * a);
+    let s1 = 2.0 * sh * ch;
+    let s2 = s1 * s1;
+    let cx = 1.0 - 2.0 * sh * sh;
+    let pi = 3.14159265358979;
+    var p_prev = 1.0;
+    var pl = cx;
+    var dp_prev = 0.0;
+    var dp = 1.0;
+    var s = 0.0;
+    for (var l = 0u; l < n; l++) {
+        var kl = 4.0 * pi * sh * sh;
+        if (l > 0u) {
+            let lf = f32(l);
+            kl = 2.0 * pi * s2 * dp / (lf * (lf + 1.0));
+            let p_next = ((2.0 * lf + 1.0) * cx * pl - lf * p_prev) / (lf + 1.0);
+            let dp_next = dp_prev + (2.0 * lf + 1.0) * pl;
+            p_prev = pl;
+            pl = p_next;
+            dp_prev = dp;
+            dp = dp_next;
+        }
+        for (var k = l * l; k < (l + 1u) * (l + 1u); k++) {
+            s = s + table[coeffs + k] * (ybuf[k] * kl);
+        }
+    }
+    let g = cos_j * h / (pi * radius * radius);
+    output[i] = power * e * g * s;
+}
