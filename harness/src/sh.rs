@@ -99,13 +99,14 @@ pub fn sphrs_set(bands: usize) -> sphrs::HarmonicsSet<f64, sphrs::RealSH> {
     sphrs::HarmonicsSet::new(bands.saturating_sub(1), sphrs::RealSH::Spherical)
 }
 
-/// Multiply–add pairs per nanosecond of this binary on this machine on four `f64` lanes
+/// Multiply–add pairs per nanosecond (counted per lane) of this binary on this machine on
+/// four `f64` lanes
 /// (`wide::f64x4`, the SIMD twin's type): eight independent `a = a·b + c` chains (median of
 /// five runs after a warm-up), a multiply and an add, not a fused multiply-add (the SH
 /// recurrence compiles to those). The one-lane rate is a quarter of it: the same execution
 /// units run both, and a scalar loop cannot be timed on its own, because the compiler
 /// packs independent scalar chains into vectors.
-pub fn mul_add_rate() -> MulAddRate {
+pub fn mul_add_rate() -> f64 {
     use wide::f64x4;
     let iters = 20_000_000u64;
     let lanes = || {
@@ -122,20 +123,55 @@ pub fn mul_add_rate() -> MulAddRate {
         black_box(a);
     };
     let t = crate::report::timing::median_time(5, lanes);
-    let simd = iters as f64 / (t.as_secs_f64() * 1e9);
-    MulAddRate {
-        scalar: simd / 4.0,
-        simd,
-    }
+    iters as f64 / (t.as_secs_f64() * 1e9)
 }
 
-/// What [`mul_add_rate`] measured: multiply–add pairs per nanosecond.
-#[derive(Clone, Copy, Debug)]
-pub struct MulAddRate {
-    /// One `f64` lane: a quarter of [`MulAddRate::simd`].
-    pub scalar: f64,
-    /// Four `f64` lanes at a time (pairs counted per lane).
-    pub simd: f64,
+/// The input rows of `wgsl::SH_HVL`, one per HVL: centre, its frame's tangent, bitangent
+/// and normal, radius, power.
+pub fn hvl_gpu_rows(hvls: &[hvl::Hvl]) -> Vec<[f32; 14]> {
+    hvls.iter()
+        .map(|h| {
+            let f = h.frame();
+            let (t, b, n) = (f.to_world(Vec3::X), f.to_world(Vec3::Y), f.normal());
+            let p = h.position();
+            [
+                p.x,
+                p.y,
+                p.z,
+                t.x,
+                t.y,
+                t.z,
+                b.x,
+                b.y,
+                b.z,
+                n.x,
+                n.y,
+                n.z,
+                h.radius(),
+                h.power(),
+            ]
+        })
+        .collect()
+}
+
+/// The table of `wgsl::SH_HVL` for the receiver `rx` and the HVLs' emission `F′`:
+/// `[n, n_e, point, frame tangent, bitangent, normal, F, F′]` (a count that is not a square
+/// gives 0 bands).
+pub fn hvl_gpu_table(rx: &hvl::Receiver<'_>, emission: &[f32]) -> Vec<f32> {
+    let bands = |len: usize| steradian_core::sh::bands_of(len).map_or(0.0, |n| n as f32);
+    let f = &rx.frame;
+    let mut table = vec![bands(rx.coeffs.len()), bands(emission.len())];
+    for q in [
+        rx.point,
+        f.to_world(Vec3::X),
+        f.to_world(Vec3::Y),
+        f.normal(),
+    ] {
+        table.extend([q.x, q.y, q.z]);
+    }
+    table.extend(rx.coeffs);
+    table.extend(emission);
+    table
 }
 
 // ---- The HVL scene of Table 1 -------------------------------------------------------------

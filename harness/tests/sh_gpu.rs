@@ -278,41 +278,8 @@ fn sh_hvl_gpu_matches_scalar() {
                 .unwrap()
             })
             .collect();
-        let rows: Vec<[f32; 14]> = hvls
-            .iter()
-            .map(|h| {
-                let f = h.frame();
-                let (t, b, nn) = (f.to_world(Vec3::X), f.to_world(Vec3::Y), f.normal());
-                let p = h.position();
-                [
-                    p.x,
-                    p.y,
-                    p.z,
-                    t.x,
-                    t.y,
-                    t.z,
-                    b.x,
-                    b.y,
-                    b.z,
-                    nn.x,
-                    nn.y,
-                    nn.z,
-                    h.radius(),
-                    h.power(),
-                ]
-            })
-            .collect();
-        let (t, b, nn) = (
-            rx.frame.to_world(Vec3::X),
-            rx.frame.to_world(Vec3::Y),
-            rx.frame.normal(),
-        );
-        let mut table = vec![n as f32, ne as f32];
-        for q in [rx.point, t, b, nn] {
-            table.extend([q.x, q.y, q.z]);
-        }
-        table.extend(&coeffs);
-        table.extend(&emission);
+        let rows = steradian_harness::sh::hvl_gpu_rows(&hvls);
+        let table = steradian_harness::sh::hvl_gpu_table(&rx, &emission);
         let input = Columns::from_rows(&rows);
         let mut out = Columns::zeros(1, rows.len());
         let custom = Custom {

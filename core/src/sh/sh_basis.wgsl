@@ -1,6 +1,7 @@
 // steradian: all bands² real SH at a direction in f32 (mirrors `sh::eval_into`), the shared
-// part of the SH kernels (`sh_eval.wgsl`, `sh_cap.wgsl`, `sh_irradiance.wgsl`):
-// `sh_basis(d, bands)` fills `ybuf[l² + l + m]` for `bands ≤ 16`. The scalar kernel's
+// part of the SH kernels (`sh_eval.wgsl`, `sh_cap.wgsl`, `sh_irradiance.wgsl`,
+// `sh_hvl.wgsl`): `sh_basis(d, bands)` fills `ybuf[l² + l + m]` for `bands ≤ 16`, and
+// `sh_cap_scale(a, bands)` turns that basis at a cap's axis into the cap's coefficients. The scalar kernel's
 // recurrence in f32, in its homogeneous form (`r² = x² + y² + z²` kept: an f32 unit vector
 // is a few 1e-8 off the sphere, and the Legendre coefficients amplify that; the f64 scalar
 // kernel does not see it), the direction scaled by its largest component and normalised
@@ -80,6 +81,40 @@ fn sh_basis(d_in: vec3<f32>, bands: u32) {
             ybuf[at2 - m] = q * s;
             q2 = q1;
             q1 = q;
+        }
+    }
+}
+
+// The basis in `ybuf` at a cap's axis times each band's factor (mirrors
+// `sh::cap::band_scales`): k_l = √(4π/(2l+1))·L̃_l = 2π·sin²a·P_l′(cos a)/(l(l+1)),
+// k_0 = 4π·sin²(a/2), P_l′ by the derivative recurrence P′_{l+1} = P′_{l−1} + (2l+1)·P_l (a
+// sum of positive terms near cos a = 1: no cancellation for small caps), sin a and cos a from
+// a/2 as `sh::cap::cap_trig`. `ybuf` then holds ∫_cap Y_l^m dω of the cap of half-angle `a`.
+fn sh_cap_scale(a: f32, bands: u32) {
+    let sh = sin(0.5 * a);
+    let ch = cos(0.5 * a);
+    let s = 2.0 * sh * ch;
+    let s2 = s * s;
+    let x = 1.0 - 2.0 * sh * sh;
+    let pi = 3.14159265358979;
+    var p_prev = 1.0;
+    var p = x;
+    var dp_prev = 0.0;
+    var dp = 1.0;
+    for (var l = 0u; l < bands; l++) {
+        var k = 4.0 * pi * sh * sh;
+        if (l > 0u) {
+            let lf = f32(l);
+            k = 2.0 * pi * s2 * dp / (lf * (lf + 1.0));
+            let p_next = ((2.0 * lf + 1.0) * x * p - lf * p_prev) / (lf + 1.0);
+            let dp_next = dp_prev + (2.0 * lf + 1.0) * p;
+            p_prev = p;
+            p = p_next;
+            dp_prev = dp;
+            dp = dp_next;
+        }
+        for (var c = l * l; c < (l + 1u) * (l + 1u); c++) {
+            ybuf[c] = ybuf[c] * k;
         }
     }
 }

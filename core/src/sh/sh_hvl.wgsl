@@ -1,8 +1,8 @@
 // steradian: one HVL's contribution to one receiver per invocation (mirrors
 // `sh::hvl::contribution` with the smoothstep horizon, in f32): the geometry of
 // `sh::hvl::prepare`, the emission F′·Y(−ω_j) in the HVL's frame and the cap toward the HVL
-// in the receiver's frame dotted with its F (the basis of `sh_basis`, the cap's band factors
-// 2π·sin²a·P_l′(cos a)/(l(l+1)) as `sh_cap.wgsl`), then P·e·G·s.
+// in the receiver's frame dotted with its F (`sh_basis` and `sh_cap_scale` of
+// `sh_basis.wgsl`), then P·e·G·s.
 // Input columns (one row per HVL): [px, py, pz, tx, ty, tz, bx, by, bz, nx, ny, nz, r, P]
 // (centre, the HVL frame's tangent, bitangent and normal, radius, power). Output: one
 // column. Table (binding 3): [n, ne, x, y, z, rtx, rty, rtz, rbx, rby, rbz, rnx, rny, rnz,
@@ -77,33 +77,12 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     }
     // The cap toward the HVL in the receiver's frame, dotted with F.
     sh_basis(vec3<f32>(dot(w, rt), dot(w, rb), dot(w, rn)), n);
-    let sh = sin(0.5 * a);
-    let ch = cos(0.5 * a);
-    let s1 = 2.0 * sh * ch;
-    let s2 = s1 * s1;
-    let cx = 1.0 - 2.0 * sh * sh;
-    let pi = 3.14159265358979;
-    var p_prev = 1.0;
-    var pl = cx;
-    var dp_prev = 0.0;
-    var dp = 1.0;
+    sh_cap_scale(a, n);
     var s = 0.0;
-    for (var l = 0u; l < n; l++) {
-        var kl = 4.0 * pi * sh * sh;
-        if (l > 0u) {
-            let lf = f32(l);
-            kl = 2.0 * pi * s2 * dp / (lf * (lf + 1.0));
-            let p_next = ((2.0 * lf + 1.0) * cx * pl - lf * p_prev) / (lf + 1.0);
-            let dp_next = dp_prev + (2.0 * lf + 1.0) * pl;
-            p_prev = pl;
-            pl = p_next;
-            dp_prev = dp;
-            dp = dp_next;
-        }
-        for (var k = l * l; k < (l + 1u) * (l + 1u); k++) {
-            s = s + table[coeffs + k] * (ybuf[k] * kl);
-        }
+    for (var k = 0u; k < n * n; k++) {
+        s = s + table[coeffs + k] * ybuf[k];
     }
+    let pi = 3.14159265358979;
     let g = cos_j * h / (pi * radius * radius);
     output[i] = power * e * g * s;
 }

@@ -241,13 +241,14 @@ pub const SH_ROTATE_TOL: f32 = 1.0e-6;
 
 /// One HVL's contribution to one receiver per invocation (`sh::hvl::contribution` with
 /// `Horizon::Smoothstep`) in `f32`, for `n, n_e ≤ 16` bands: the geometry of
-/// `sh::hvl::prepare`, the emission and cap through the basis of [`SH_EVAL`] and the cap
-/// factors of [`SH_CAP`]. Input columns `[px, py, pz, tx, ty, tz, bx, by, bz, nx, ny, nz, r,
-/// P]` per HVL (its frame's tangent, bitangent, normal); output one column; binding 3 is
+/// `sh::hvl::prepare`, the emission and cap through the basis and cap factors of
+/// [`SH_CAP`] (`sh_basis.wgsl`). Input columns `[px, py, pz, tx, ty, tz, bx, by, bz, nx, ny,
+/// nz, r, P]` per HVL (its frame's tangent, bitangent, normal); output one column; binding 3 is
 /// `[n, n_e, x, y, z, t, b, n (receiver frame, 9 values), F (n²), F′ (n_e²)]`. Neither in
 /// [`ALL`] nor in [`CUSTOM`]: one HVL's contribution is not a registered kernel (no `eval`
 /// contract); wgpu validates it when the harness test `tests/sh_gpu.rs` and the report's SH
-/// section build it. Tolerance: [`SH_HVL_TOL`].
+/// section build it (both pack it with `steradian_harness::sh::hvl_gpu_rows` and
+/// `hvl_gpu_table`). Tolerance: [`SH_HVL_TOL`].
 pub const SH_HVL: &str = concat!(
     include_str!("batch.wgsl"),
     include_str!("../sh/sh_basis.wgsl"),
@@ -256,8 +257,8 @@ pub const SH_HVL: &str = concat!(
 /// Absolute difference allowed between [`SH_HVL`] and `sh::hvl::contribution`, per unit of
 /// the largest `|contribution|` among the HVLs lighting the receiver (the horizon term's
 /// slope carries the GPU's trigonometry into the smallest contributions). The kernel's
-/// `asin` goes through `atan2` with `√((1 − x)(1 + x))`: lavapipe's own `asin` is off by
-/// `2e-4` of the largest contribution near `|x| = 1`. Lavapipe: `7.3e-6` over 2000 random
+/// `asin` goes through `atan2` with `√((1 − x)(1 + x))`: lavapipe's own `asin` misses this
+/// tolerance near `|x| = 1`. Lavapipe: `7.3e-6` over 2000 random
 /// HVLs at 1–14 bands (harness test `tests/sh_gpu.rs`, which prints them).
 pub const SH_HVL_TOL: f32 = 2.0e-5;
 

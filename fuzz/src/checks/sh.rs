@@ -46,6 +46,11 @@ fn check_rotation(rot: &Rotation, c: &[f32], bands: usize) {
     );
 }
 
+/// Equal bits, or both NaN (a NaN's payload may differ between the twins).
+fn same_bits(a: f32, b: f32) -> bool {
+    a.to_bits() == b.to_bits() || (a.is_nan() && b.is_nan())
+}
+
 fn f32_at(d: &[u8], at: usize) -> f32 {
     let b: [u8; 4] = core::array::from_fn(|k| d.get(at + k).copied().unwrap_or(0));
     f32::from_le_bytes(b)
@@ -90,10 +95,7 @@ pub fn check(data: &[u8]) {
         if scalar.is_ok() {
             for k in 0..n {
                 let (s, v) = (cols[k * 4 + i], c[k]);
-                assert!(
-                    s.to_bits() == v.to_bits() || (s.is_nan() && v.is_nan()),
-                    "cap {d} {a} k {k}: {s} vs {v}"
-                );
+                assert!(same_bits(s, v), "cap {d} {a} k {k}: {s} vs {v}");
             }
         }
     }
@@ -112,11 +114,7 @@ pub fn check(data: &[u8]) {
     .expect("valid shapes");
     for (i, d) in dirs.iter().enumerate() {
         let e = sh::irradiance::irradiance(&radiance, *d, &mut c).expect("square length");
-        assert!(
-            e.to_bits() == e4[i].to_bits() || (e.is_nan() && e4[i].is_nan()),
-            "irradiance {d}: {} vs {e}",
-            e4[i]
-        );
+        assert!(same_bits(e, e4[i]), "irradiance {d}: {} vs {e}", e4[i]);
     }
     steradian_simd::sh::eval_slices(&x, &y, &z, bands, &mut cols).expect("valid shapes");
     let mut one = vec![0.0f32; n];
@@ -124,10 +122,7 @@ pub fn check(data: &[u8]) {
         sh::eval_into(*d, bands, &mut one).expect("valid band count");
         for k in 0..n {
             let (a, b) = (cols[k * 4 + i], one[k]);
-            assert!(
-                a.to_bits() == b.to_bits() || (a.is_nan() && b.is_nan()),
-                "{d} k {k}: {a} vs {b}"
-            );
+            assert!(same_bits(a, b), "{d} k {k}: {a} vs {b}");
         }
         if d.is_finite() {
             assert!(one.iter().all(|v| v.is_finite()), "{d}: non-finite SH");

@@ -26,60 +26,41 @@ pub fn contributions_x4(
     let n = bands_of(rx.coeffs.len())?;
     let ne = bands_of(emission.len())?;
     check_shape(n.max(ne), scratch.len())?;
-    let prep = hvls.map(|h| prepare(h, rx.point, &rx.frame, horizon));
-    let value = |k: usize| match prep[k] {
-        Prepared::Value(v) => Some(v),
-        Prepared::Lit { .. } => None,
-    };
-    if (0..4).all(|k| value(k).is_some()) {
-        return Ok(core::array::from_fn(|k| value(k).unwrap_or(0.0)));
+    // Each lane's geometry; settled lanes keep their value and run the SH part on a harmless
+    // stand-in (+z, a zero cap, zero power), whose result is not used.
+    let mut value: [Option<f32>; 4] = [None; 4];
+    let (mut emit, mut axis) = ([Vec3::Z; 4], [Vec3::Z; 4]);
+    let (mut angle, mut power, mut g) = ([0.0f32; 4], [0.0f32; 4], [0.0f32; 4]);
+    for (k, h) in hvls.iter().enumerate() {
+        match prepare(h, rx.point, &rx.frame, horizon) {
+            Prepared::Value(v) => value[k] = Some(v),
+            Prepared::Lit {
+                emit_dir,
+                cap_axis,
+                half_angle,
+                power: p,
+                g: gk,
+            } => {
+                (emit[k], axis[k], angle[k], power[k], g[k]) =
+                    (emit_dir, cap_axis, half_angle, p, gk);
+            }
+        }
     }
-    // Settled lanes run on a harmless stand-in (+z, a zero cap) and are not used.
-    let lit = |f: fn(&Prepared) -> Option<f32>| {
-        f32x4::new(core::array::from_fn(|k| f(&prep[k]).unwrap_or(0.0)))
-    };
-    let dir = |f: fn(&Prepared) -> Option<Vec3>| {
-        core::array::from_fn::<Vec3, 4, _>(|k| f(&prep[k]).unwrap_or(Vec3::Z))
-    };
-    super::eval_x4(
-        dir(|p| match p {
-            Prepared::Lit { emit_dir, .. } => Some(*emit_dir),
-            _ => None,
-        }),
-        ne,
-        scratch,
-    )?;
+    if value.iter().all(Option::is_some) {
+        return Ok(value.map(|v| v.unwrap_or(0.0)));
+    }
+    super::eval_x4(emit, ne, scratch)?;
     let mut e = f32x4::ZERO;
     for (a, y) in emission.iter().zip(scratch.iter()) {
         e += f32x4::splat(*a) * f32x4::new(*y);
     }
-    let angles = lit(|p| match p {
-        Prepared::Lit { half_angle, .. } => Some(*half_angle),
-        _ => None,
-    });
-    super::cap::coefficients_x4(
-        dir(|p| match p {
-            Prepared::Lit { cap_axis, .. } => Some(*cap_axis),
-            _ => None,
-        }),
-        angles.to_array(),
-        n,
-        scratch,
-    )?;
+    super::cap::coefficients_x4(axis, angle, n, scratch)?;
     let mut s = f32x4::ZERO;
     for (f, c) in rx.coeffs.iter().zip(scratch.iter()) {
         s += f32x4::splat(*f) * f32x4::new(*c);
     }
-    let power = lit(|p| match p {
-        Prepared::Lit { power, .. } => Some(*power),
-        _ => None,
-    });
-    let g = lit(|p| match p {
-        Prepared::Lit { g, .. } => Some(*g),
-        _ => None,
-    });
-    let r = (power * e * g * s).to_array();
-    Ok(core::array::from_fn(|k| value(k).unwrap_or(r[k])))
+    let r = (f32x4::new(power) * e * f32x4::new(g) * s).to_array();
+    Ok(core::array::from_fn(|k| value[k].unwrap_or(r[k])))
 }
 
 /// [`contributions_x4`] over a slice of HVLs: `out[j]` is HVL `j`'s contribution to `rx`.
