@@ -212,15 +212,22 @@ fn cell(x: f32, n: usize) -> (usize, f32) {
 }
 
 /// The table's exponent coordinate `u = ln(1 + e/ε)/ln(1 + E/ε)`, clamped to `[0, 1]`.
+///
+/// `ln` of the rounded `1 + e/ε`, not `log1p`: a coordinate needs absolute, not relative,
+/// precision, and rounding `1 + e/ε` moves `ln` by at most `2⁻²⁴` (`u` by `4e-9`, a
+/// `2.6e-7` fraction of a cell of the built-in table), where `log1p` costs twice `ln`.
 #[inline]
 pub fn exponent_coord(e: f32) -> f32 {
     // ln(1 + E/ε) = ln(2e6 + 1).
     const INV_LN_SPAN: f32 = 1.0 / 14.508_658;
-    (math::log1pf(e.max(0.0) / EXPONENT_EPS) * INV_LN_SPAN).min(1.0)
+    (math::logf(1.0 + e.max(0.0) * (1.0 / EXPONENT_EPS)) * INV_LN_SPAN).min(1.0)
 }
 
 /// `(1 ± cos φ)` of the angle `φ = atan2(sn, cs)` (`sn ≥ 0`), each without cancellation:
-/// `(1 − cos φ, 1 + cos φ)`.
+/// `(1 − cos φ, 1 + cos φ)`. With `h = |(sn, cs)|` and `h⁺ = h + |cs|`,
+/// `1 + |cos φ| = h⁺/h = h⁺²/(h·h⁺)` and `1 − |cos φ| = sn²/(h·h⁺)` (`(1 − |cos|)(1 + |cos|)
+/// = sin²`): one division for both; the sign of `cs` says which is which. The callers'
+/// pairs have `h ≈ 1` (a sine and cosine up to rounding), so `h·h⁺ ∈ [1, 2]` roughly.
 #[inline]
 fn one_pm_cos(sn: f32, cs: f32) -> (f32, f32) {
     let h = math::sqrtf(sn * sn + cs * cs);
@@ -243,13 +250,13 @@ fn one_pm_cos(sn: f32, cs: f32) -> (f32, f32) {
 fn peak_pair(s: f32, c: f32, r: f32, omr2: f32, cy: f32) -> (f32, f32) {
     // 2t* = α − asin(r'·sin α) with r' = −r here (t* from axis 1 grows toward axis 2 when
     // e1 < e2); sin and cos of that difference, with cos y = cy = √(c² + (1 − r²)s²).
+    // Both forms of the sine, then a select (random pairs take both): s·(1 − r²)/(cy + rc)
+    // where rc ≥ 0 (no cancellation), s·(cy − rc) otherwise.
     let rc = -r * c;
-    let sn = if rc >= 0.0 {
-        let den = cy + rc;
-        if den > 0.0 { s * omr2 / den } else { 0.0 }
-    } else {
-        s * (cy - rc)
-    };
+    let den = cy + rc;
+    let quot = s * omr2 / den;
+    let pos = if den > 0.0 { quot } else { 0.0 };
+    let sn = if rc >= 0.0 { pos } else { s * (cy - rc) };
     let cs = c * cy - r * s * s;
     (sn, cs)
 }
@@ -261,14 +268,93 @@ fn ratio(f1: f32, f2: f32) -> (f32, f32) {
     ((f2 - f1) / n, 4.0 * (f1 / n) * (f2 / n))
 }
 
-/// `ln cos t` from `(1 − cos 2t, 1 + cos 2t)`: `½·ln((1 + cos 2t)/2)`, through `log1p`
-/// when `t` is small so that `e·ln cos t` keeps its relative precision at `e = 1e5`.
+/// `ln cos t` from `(1 − cos 2t, 1 + cos 2t)`: `½·ln((1 + cos 2t)/2)`, through
+/// `ln(1 + x)` with `x = −(1 − cos 2t)/2` when `t` is small so that `e·ln cos t` keeps its
+/// relative precision at `e = 1e5`. One `ln` either way: `ln(1 + x) = ln(u)·x/(u − 1)` with
+/// `u = 1 + x` rounded (Goldberg 1991, theorem 4: the rounding of `u` cancels between
+/// `ln u` and `u − 1`; within a few ulps of `ln(1 + x)`), `x` itself where `u = 1`.
 #[inline]
 fn ln_cos_half(omc: f32, opc: f32) -> f32 {
-    if omc < opc {
-        0.5 * math::log1pf(-0.5 * omc)
+    // One `ln` of a selected argument and a selected factor, no branch (random angles
+    // take both sides).
+    let small = omc < opc;
+    let x = -0.5 * omc;
+    let u = 1.0 + x;
+    let l = math::logf(if small { u } else { 0.5 * opc });
+    let k = x / (u - 1.0);
+    0.5 * if !small {
+        l
+    } else if u == 1.0 {
+        x
     } else {
-        0.5 * math::logf(0.5 * opc)
+        l * k
+    }
+}
+
+/// `atan2(y, x)` for `y ≥ 0` (`[0, π]`), NaN for NaN: Cephes' `atanf` (Moshier 1989) after
+/// the reduction to `[0, tan(π/8)]` — `atan t = π/4 + atan((t − 1)/(t + 1))` above
+/// `tan(π/8)`, `atan t = π/2 − atan(1/t)` above 1 (by swapping `y` and `|x|`), `π − ·` for
+/// `x < 0` — whose degree-9 odd polynomial is within `1.9e-7` relative of `atan` there;
+/// full relative precision for small results (`atan z = z + z³·p(z²)`). The same function
+/// as the WGSL twin's `atan2_`, selects instead of branches (random inputs take all of
+/// them). The baseline needs its angles to a few ulps, not correctly rounded: they enter
+/// `ln B` through `1/x`, `x·y/(x + y)` and their logarithms.
+#[inline(always)]
+fn atan2_pos(y: f32, x: f32) -> f32 {
+    let ax = x.abs();
+    let swap = y > ax;
+    let (num, den) = if swap { (ax, y) } else { (y, ax) };
+    // t = num/den ∈ [0, 1]; above tan(π/8), z = (t − 1)/(t + 1) = (num − den)/(num + den):
+    // one division either way. den = 0 only for y = x = 0: atan2(0, ±0) is 0 or π, as for
+    // z = 0 below.
+    let big = num > 0.414_213_57 * den;
+    let (zn, zd) = if big {
+        (num - den, num + den)
+    } else {
+        (num, den)
+    };
+    let z = if zd > 0.0 { zn / zd } else { 0.0 };
+    let base = if big {
+        core::f32::consts::FRAC_PI_4
+    } else {
+        0.0
+    };
+    let zz = z * z;
+    let p = ((0.080_537_445 * zz - 0.138_776_86) * zz + 0.199_777_11) * zz - 0.333_329_5;
+    let r = base + (z + z * zz * p);
+    let r = if swap {
+        core::f32::consts::FRAC_PI_2 - r
+    } else {
+        r
+    };
+    // atan2(y, −0) is π/2 for y > 0 (r = π/2 already) and π for y = 0 (r = 0).
+    let r = if x.is_sign_negative() {
+        crate::PI - r
+    } else {
+        r
+    };
+    if y.is_nan() || x.is_nan() {
+        f32::NAN
+    } else {
+        r
+    }
+}
+
+/// `e^y` as `math::expf` gives it, without its slow path for results that overflow or
+/// underflow to zero (`expf` is `0` below `−103.98` and `+∞` above `88.73`): random lobe
+/// pairs reach both all the time (`e·ln cos t` of a sharp lobe far from its axis).
+#[inline(always)]
+fn exp_fast(y: f32) -> f32 {
+    // Selects around one call with an argument that stays on `expf`'s fast path.
+    let low = y < -104.0;
+    let high = y > 89.0;
+    let q = math::expf(if low | high { 0.0 } else { y });
+    if low {
+        0.0
+    } else if high {
+        f32::INFINITY
+    } else {
+        q
     }
 }
 
@@ -288,24 +374,11 @@ pub struct Baseline {
     pub arc_curvature: f32,
 }
 
-/// The closed-form part of the product of unit lobes with exponents `e1, e2` (clamped to
-/// `≥ 0`) whose axes are `α` apart, given `cos α` and `sin α ≥ 0`. For `α = π` (`sin α = 0`,
-/// `cos α < 0`) `ln_b = −∞`. NaN in → NaN out.
-pub fn baseline(e1: f32, e2: f32, cos_a: f32, sin_a: f32) -> Baseline {
-    let (e1, e2) = (e1.max(0.0), e2.max(0.0));
-    let (s, c) = (sin_a.max(0.0), cos_a);
-    let nan = e1.is_nan() || e2.is_nan() || s.is_nan() || c.is_nan();
-    if nan {
-        return Baseline {
-            ln_b: f32::NAN,
-            w: f32::NAN,
-            peak_dir: (f32::NAN, f32::NAN),
-            ln_peak: f32::NAN,
-            arc_curvature: f32::NAN,
-        };
-    }
-    // The peak of the product itself (exponents e1, e2): direction and value.
-    let (peak_dir, ln_peak, arc_curvature) = if e1 + e2 > 0.0 && (e1 + e2).is_finite() {
+/// The peak of the product itself (exponents `e1, e2 ≥ 0`, not NaN): `(cos t*, sin t*)`,
+/// `ln` of the peak value and the curvature along the arc (see [`Baseline`]).
+#[inline(always)]
+fn peak(e1: f32, e2: f32, c: f32, s: f32) -> ((f32, f32), f32, f32) {
+    if e1 + e2 > 0.0 && (e1 + e2).is_finite() {
         let (r, omr2) = ratio(e1, e2);
         let cy = math::sqrtf(c * c + omr2 * s * s);
         let (sn1, cs1) = peak_pair(s, c, r, omr2, cy);
@@ -334,9 +407,25 @@ pub fn baseline(e1: f32, e2: f32, cos_a: f32, sin_a: f32) -> Baseline {
             0.0,
             e1 + e2,
         )
-    };
+    }
+}
 
-    // Laplace in the logit variable around the peak of sin^(e1+1)·sin^(e2+1) on the lune.
+/// The peak of `sin^(e1+1)(x)·sin^(e2+1)(y)` on the lune (`x`, `y` the angles from the
+/// horizons of `a1` and `a2`, `x + y = π − α`), where Laplace's method in the logit variable
+/// expands: `(sin, cos)` of `2x` and `2y`, their `1 ∓ cos`, `ln sin x`, `ln sin y` and the
+/// table's angle coordinate `w` — everything the table lookup needs, so that its loads can
+/// start before the rest of the baseline is computed.
+#[derive(Clone, Copy, Debug)]
+struct Horizons {
+    sc: [f32; 4],
+    omc: [f32; 2],
+    opc: [f32; 2],
+    ln_sin: [f32; 2],
+    w: f32,
+}
+
+#[inline(always)]
+fn horizons(e1: f32, e2: f32, c: f32, s: f32) -> Horizons {
     let (f1, f2) = (e1 + 1.0, e2 + 1.0);
     let (r, omr2) = ratio(f1, f2);
     // Angles from the two horizons: x (from a1's horizon) = π/2 − t, y = π/2 − u; with
@@ -344,44 +433,90 @@ pub fn baseline(e1: f32, e2: f32, cos_a: f32, sin_a: f32) -> Baseline {
     let cy = math::sqrtf(c * c + omr2 * s * s);
     let (snx, csx) = peak_pair(s, -c, -r, omr2, cy);
     let (sny, csy) = peak_pair(s, -c, r, omr2, cy);
-    let x = 0.5 * math::atan2f(snx, csx);
-    let y = 0.5 * math::atan2f(sny, csy);
-    if !(x > 0.0 && y > 0.0) {
-        // α = π: the open hemispheres are disjoint.
-        return Baseline {
-            ln_b: f32::NEG_INFINITY,
-            w: 1.0,
-            peak_dir,
-            ln_peak,
-            arc_curvature,
-        };
-    }
     let (omcx, opcx) = one_pm_cos(snx, csx);
     let (omcy, opcy) = one_pm_cos(sny, csy);
     // ln sin x = ln cos(π/2 − x): sin²x = (1 − cos 2x)/2.
     let ln_sin_x = ln_cos_half(opcx, omcx);
     let ln_sin_y = ln_cos_half(opcy, omcy);
-    let w = math::sqrtf((-(f1 * ln_sin_x + f2 * ln_sin_y) / ANGLE_LOG_DROP).clamp(0.0, 1.0));
-
-    let l = x + y;
-    let m = x * y / l;
-    let cot_x = math::sqrtf(opcx / omcx);
-    let cot_y = math::sqrtf(opcy / omcy);
-    let a = e1 * cot_x + 1.0 / x;
-    let b = e2 * cot_y + 1.0 / y;
-    let d = a - b;
-    let phi0 = e1 * ln_sin_x + e2 * ln_sin_y + math::logf(m);
-    let phi1 = d * m;
-    let ap = e1 * 2.0 / omcx + 1.0 / (x * x);
-    let bp = e2 * 2.0 / omcy + 1.0 / (y * y);
-    // −φ'' (positive), floored so that a degenerate case cannot divide by zero.
-    let h = (m * m * (ap + bp) - d * (y - x) * m / l).max(1e-30);
-    let n = e1 + e2;
-    let ln_k = 0.5 * math::logf(TWO_PI / (n + 1.5));
-    let ln_b = ln_k + phi0 + phi1 * phi1 / (2.0 * h) + 0.5 * math::logf(TWO_PI / h);
-    Baseline {
-        ln_b,
+    let w =
+        math::sqrtf((-(f1 * ln_sin_x + f2 * ln_sin_y) * (1.0 / ANGLE_LOG_DROP)).clamp(0.0, 1.0));
+    Horizons {
+        sc: [snx, csx, sny, csy],
+        omc: [omcx, omcy],
+        opc: [opcx, opcy],
+        ln_sin: [ln_sin_x, ln_sin_y],
         w,
+    }
+}
+
+/// `ln B` from the horizons' peak; `None` where the open hemispheres are disjoint (`α = π`:
+/// `ln B = −∞`).
+#[inline(always)]
+fn ln_baseline(e1: f32, e2: f32, hz: &Horizons) -> Option<f32> {
+    let [snx, csx, sny, csy] = hz.sc;
+    let ([omcx, omcy], [opcx, opcy]) = (hz.omc, hz.opc);
+    let [ln_sin_x, ln_sin_y] = hz.ln_sin;
+    let x = 0.5 * atan2_pos(snx, csx);
+    let y = 0.5 * atan2_pos(sny, csy);
+    if !(x > 0.0 && y > 0.0) {
+        // α = π: the open hemispheres are disjoint.
+        return None;
+    }
+    let l = x + y;
+    // Reciprocals once (each is used twice): cot²x = (1 + cos 2x)/(1 − cos 2x),
+    // csc²x = 2/(1 − cos 2x).
+    let (ix, iy, il) = (1.0 / x, 1.0 / y, 1.0 / l);
+    let (iox, ioy) = (1.0 / omcx, 1.0 / omcy);
+    let m = x * y * il;
+    let cot_x = math::sqrtf(opcx * iox);
+    let cot_y = math::sqrtf(opcy * ioy);
+    let a = e1 * cot_x + ix;
+    let b = e2 * cot_y + iy;
+    let d = a - b;
+    let phi1 = d * m;
+    let ap = e1 * 2.0 * iox + ix * ix;
+    let bp = e2 * 2.0 * ioy + iy * iy;
+    // −φ'' (positive), floored so that a degenerate case cannot divide by zero.
+    let h = (m * m * (ap + bp) - d * (y - x) * m * il).max(1e-30);
+    let n15 = e1 + e2 + 1.5;
+    // ln K(n) + ln m + ½·ln(2π/h) = ½·ln((2π·m)²/((n + 1.5)·h)) with K ≈ √(2π/(n + 1.5)):
+    // one logarithm, or three where that argument leaves the normal range; and
+    // φ₁²/(2h) = φ₁²·(n + 1.5)/(2·(n + 1.5)·h) from the same reciprocal.
+    let inv = 1.0 / (n15 * h);
+    let q = (TWO_PI * m) * (TWO_PI * m) * inv;
+    let (logs, quad) = if (f32::MIN_POSITIVE..=f32::MAX).contains(&q) && inv <= f32::MAX {
+        (0.5 * math::logf(q), phi1 * phi1 * (0.5 * n15) * inv)
+    } else {
+        (
+            0.5 * math::logf(TWO_PI / n15) + math::logf(m) + 0.5 * math::logf(TWO_PI / h),
+            phi1 * phi1 / (2.0 * h),
+        )
+    };
+    Some(e1 * ln_sin_x + e2 * ln_sin_y + logs + quad)
+}
+
+/// The closed-form part of the product of unit lobes with exponents `e1, e2` (clamped to
+/// `≥ 0`) whose axes are `α` apart, given `cos α` and `sin α ≥ 0`. For `α = π` (`sin α = 0`,
+/// `cos α < 0`) `ln_b = −∞`. NaN in → NaN out.
+pub fn baseline(e1: f32, e2: f32, cos_a: f32, sin_a: f32) -> Baseline {
+    let (e1, e2) = (e1.max(0.0), e2.max(0.0));
+    let (s, c) = (sin_a.max(0.0), cos_a);
+    let nan = e1.is_nan() || e2.is_nan() || s.is_nan() || c.is_nan();
+    if nan {
+        return Baseline {
+            ln_b: f32::NAN,
+            w: f32::NAN,
+            peak_dir: (f32::NAN, f32::NAN),
+            ln_peak: f32::NAN,
+            arc_curvature: f32::NAN,
+        };
+    }
+    let hz = horizons(e1, e2, c, s);
+    let (peak_dir, ln_peak, arc_curvature) = peak(e1, e2, c, s);
+    let ln_b = ln_baseline(e1, e2, &hz);
+    Baseline {
+        ln_b: ln_b.unwrap_or(f32::NEG_INFINITY),
+        w: if ln_b.is_some() { hz.w } else { 1.0 },
         peak_dir,
         ln_peak,
         arc_curvature,
@@ -465,14 +600,33 @@ pub fn product_with(
 ) -> CosineLobe {
     let (e1, e2) = (a.exponent(), b.exponent());
     let (c, s, w) = arc_frame(a.axis(), b.axis());
-    let base = baseline(e1, e2, c, s);
-    let ln_i = match fit {
+    // `baseline`, in the order that starts the table's loads (four cache lines at random
+    // places in 1 MB) before the rest of the closed form is computed, so that the two
+    // overlap: first the horizons' peak and `w`, then the lookup, then the rest. As in
+    // `baseline`, the exponents are clamped (a NaN exponent becomes 0 here and is answered
+    // below) and a NaN `cos α` (a NaN axis) makes everything NaN; `sin α` is never NaN.
+    let (e1c, e2c) = (e1.max(0.0), e2.max(0.0));
+    let hz = horizons(e1c, e2c, c, s);
+    let g = match fit {
         ProductFit::ExactIntegral | ProductFit::ExactIntegralCurvature => {
-            base.ln_b + table.correction(exponent_coord(e1), exponent_coord(e2), base.w)
+            table.correction(exponent_coord(e1), exponent_coord(e2), hz.w)
         }
+        ProductFit::SphericalGaussian => 0.0,
+    };
+    let nan = f32::NAN;
+    let ((peak_dir, ln_peak, arc_curvature), ln_b) = if c.is_nan() {
+        (((nan, nan), nan, nan), nan)
+    } else {
+        let ln_b = ln_baseline(e1c, e2c, &hz).unwrap_or(f32::NEG_INFINITY);
+        (peak(e1c, e2c, c, s), ln_b)
+    };
+    let ln_i = match fit {
+        // `baseline` looks the table up at w = 1 where ln B = −∞; the sum is −∞ either way.
+        _ if fit != ProductFit::SphericalGaussian && ln_b == f32::NEG_INFINITY => ln_b,
+        ProductFit::ExactIntegral | ProductFit::ExactIntegralCurvature => ln_b + g,
         ProductFit::SphericalGaussian => ln_sg_integral(e1, e2, c, s),
     };
-    let (ct, st) = base.peak_dir;
+    let (ct, st) = peak_dir;
     let axis = a.axis() * ct + w * st;
     let scale = a.scale() * b.scale();
     if e1.is_nan() || e2.is_nan() {
@@ -484,7 +638,7 @@ pub fn product_with(
     }
     // s1·s2·exp(ln q), without `∞·0` when s1·s2 overflows but the product does not.
     let scaled = |ln_q: f32| {
-        let q = math::expf(ln_q);
+        let q = exp_fast(ln_q);
         if scale.is_finite() || scale.is_nan() {
             scale * q
         } else {
@@ -492,7 +646,7 @@ pub fn product_with(
         }
     };
     if fit == ProductFit::ExactIntegralCurvature {
-        let e_r = math::sqrtf((e1.max(0.0) + e2.max(0.0)) * base.arc_curvature);
+        let e_r = math::sqrtf((e1c + e2c) * arc_curvature);
         // A peak on an e < 1 lobe's horizon has no curvature to match (the lobe has a
         // kink there): the peak-matched exponent below takes over.
         if e_r.is_finite() {
@@ -503,6 +657,6 @@ pub fn product_with(
         }
     }
     // 2π·peak/(e_r + 1) = I.
-    let e_r = math::expf(LN_TWO_PI + base.ln_peak - ln_i) - 1.0;
-    CosineLobe::saturating(axis, scaled(base.ln_peak), e_r.max(0.0))
+    let e_r = exp_fast(LN_TWO_PI + ln_peak - ln_i) - 1.0;
+    CosineLobe::saturating(axis, scaled(ln_peak), e_r.max(0.0))
 }

@@ -86,8 +86,9 @@ fn ln_cos_half(omc: f32, opc: f32) -> f32 {
     return 0.5 * ln_(0.5 * opc);
 }
 
+// ln of the rounded 1 + e/ε (absolute precision suffices for a coordinate).
 fn exponent_coord(e: f32) -> f32 {
-    return min(log1p(max(e, 0.0) / EXPONENT_EPS) * INV_LN_SPAN, 1.0);
+    return min(ln_(1.0 + max(e, 0.0) * (1.0 / EXPONENT_EPS)) * INV_LN_SPAN, 1.0);
 }
 
 // The table value of pair (a, b) at angle node k, and the next one.
@@ -219,22 +220,41 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     let qy = one_pm_cos(py.x, py.y);
     let ln_sin_x = ln_cos_half(qx.y, qx.x);
     let ln_sin_y = ln_cos_half(qy.y, qy.x);
-    let wc = sqrt(clamp(-(f1 * ln_sin_x + f2 * ln_sin_y) / ANGLE_LOG_DROP, 0.0, 1.0));
+    let wc = sqrt(clamp(-(f1 * ln_sin_x + f2 * ln_sin_y) * (1.0 / ANGLE_LOG_DROP), 0.0, 1.0));
+    // The table's loads first, so that they overlap the rest of the baseline.
+    let g = correction(exponent_coord(e1), exponent_coord(e2), wc);
     let l = x + y;
-    let m = x * y / l;
-    let cot_x = sqrt(qx.y / qx.x);
-    let cot_y = sqrt(qy.y / qy.x);
-    let a = e1 * cot_x + 1.0 / x;
-    let b = e2 * cot_y + 1.0 / y;
+    let ix = 1.0 / x;
+    let iy = 1.0 / y;
+    let il = 1.0 / l;
+    let iox = 1.0 / qx.x;
+    let ioy = 1.0 / qy.x;
+    let m = x * y * il;
+    let cot_x = sqrt(qx.y * iox);
+    let cot_y = sqrt(qy.y * ioy);
+    let a = e1 * cot_x + ix;
+    let b = e2 * cot_y + iy;
     let d = a - b;
-    let phi0 = e1 * ln_sin_x + e2 * ln_sin_y + ln_(m);
     let phi1 = d * m;
-    let ap = e1 * 2.0 / qx.x + 1.0 / (x * x);
-    let bp = e2 * 2.0 / qy.x + 1.0 / (y * y);
-    let h = max(m * m * (ap + bp) - d * (y - x) * m / l, 1e-30);
-    let ln_k = 0.5 * ln_(TWO_PI / (e1 + e2 + 1.5));
-    let ln_b = ln_k + phi0 + phi1 * phi1 / (2.0 * h) + 0.5 * ln_(TWO_PI / h);
-    let ln_i = ln_b + correction(exponent_coord(e1), exponent_coord(e2), wc);
+    let ap = e1 * 2.0 * iox + ix * ix;
+    let bp = e2 * 2.0 * ioy + iy * iy;
+    let h = max(m * m * (ap + bp) - d * (y - x) * m * il, 1e-30);
+    // ln K + ln m + ½·ln(2π/h) = ½·ln((2π·m)²/((n + 1.5)·h)): one logarithm where that
+    // argument is a normal number (the scalar kernel's choice), three elsewhere.
+    let n15 = e1 + e2 + 1.5;
+    let inv = 1.0 / (n15 * h);
+    let q = (TWO_PI * m) * (TWO_PI * m) * inv;
+    var logs: f32;
+    var quad: f32;
+    if (q >= 1.1754944e-38 && q <= 3.4028235e38 && inv <= 3.4028235e38) {
+        logs = 0.5 * ln_(q);
+        quad = phi1 * phi1 * (0.5 * n15) * inv;
+    } else {
+        logs = 0.5 * ln_(TWO_PI / n15) + ln_(m) + 0.5 * ln_(TWO_PI / h);
+        quad = phi1 * phi1 / (2.0 * h);
+    }
+    let ln_b = e1 * ln_sin_x + e2 * ln_sin_y + logs + quad;
+    let ln_i = ln_b + g;
 
     // 2π·peak/(e_r + 1) = I.
     let e_r = exp(LN_TWO_PI + ln_peak - ln_i) - 1.0;

@@ -169,7 +169,8 @@ fn ln_cos_half<W: Lanes>(omc: W, opc: W) -> W {
 /// The scalar `exponent_coord`.
 #[inline(always)]
 fn exponent_coord<W: Lanes>(e: W) -> W {
-    let u = (max_num(e, W::splat(0.0)) / W::splat(EXPONENT_EPS)).ln_1p() * W::splat(INV_LN_SPAN);
+    let u = ln_full(W::splat(1.0) + max_num(e, W::splat(0.0)) * W::splat(1.0 / EXPONENT_EPS))
+        * W::splat(INV_LN_SPAN);
     min_num(u, W::splat(1.0))
 }
 
@@ -215,26 +216,34 @@ fn baseline<W: Lanes>(e1: W, e2: W, c: W, s: W) -> Baseline<W> {
     let ln_sin_x = ln_cos_half(opcx, omcx);
     let ln_sin_y = ln_cos_half(opcy, omcy);
     let w = clamp(
-        -(f1 * ln_sin_x + f2 * ln_sin_y) / W::splat(ANGLE_LOG_DROP),
+        -(f1 * ln_sin_x + f2 * ln_sin_y) * W::splat(1.0 / ANGLE_LOG_DROP),
         zero,
         one,
     )
     .sqrt();
     let l = x + y;
-    let m = x * y / l;
-    let cot_x = (opcx / omcx).sqrt();
-    let cot_y = (opcy / omcy).sqrt();
-    let a = e1 * cot_x + one / x;
-    let b = e2 * cot_y + one / y;
+    let (ix, iy, il) = (one / x, one / y, one / l);
+    let (iox, ioy) = (one / omcx, one / omcy);
+    let m = x * y * il;
+    let cot_x = (opcx * iox).sqrt();
+    let cot_y = (opcy * ioy).sqrt();
+    let a = e1 * cot_x + ix;
+    let b = e2 * cot_y + iy;
     let d = a - b;
-    let phi0 = e1 * ln_sin_x + e2 * ln_sin_y + ln_full(m);
     let phi1 = d * m;
-    let ap = e1 * W::splat(2.0) / omcx + one / (x * x);
-    let bp = e2 * W::splat(2.0) / omcy + one / (y * y);
-    let h = max_num(m * m * (ap + bp) - d * (y - x) * m / l, W::splat(1e-30));
-    let n = e1 + e2;
-    let ln_k = half * ln_full(two_pi / (n + W::splat(1.5)));
-    let ln_b = ln_k + phi0 + phi1 * phi1 / (W::splat(2.0) * h) + half * ln_full(two_pi / h);
+    let ap = e1 * W::splat(2.0) * iox + ix * ix;
+    let bp = e2 * W::splat(2.0) * ioy + iy * iy;
+    let h = max_num(m * m * (ap + bp) - d * (y - x) * m * il, W::splat(1e-30));
+    // The scalar kernel's one logarithm for ln K + ln m + ½·ln(2π/h) and its shared
+    // reciprocal; lanes where it takes its three-logarithm branch go to the scalar kernel.
+    let n15 = e1 + e2 + W::splat(1.5);
+    let inv = one / (n15 * h);
+    let tm = two_pi * m;
+    let q = tm * tm * inv;
+    let big = W::splat(f32::MAX);
+    let redo = redo | !(q.ge(W::splat(f32::MIN_POSITIVE)) & q.le(big) & inv.le(big));
+    let quad = phi1 * phi1 * (half * n15) * inv;
+    let ln_b = e1 * ln_sin_x + e2 * ln_sin_y + half * ln_full(q) + quad;
     Baseline {
         ln_b,
         w,
