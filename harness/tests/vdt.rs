@@ -274,11 +274,12 @@ fn check_family(f: Family, e9_mean: f64, grad_mean: f64, grad_max: f64) {
 /// The accuracy study: bounds a little above the measured errors (the report prints them).
 #[test]
 fn error_study_bounds() {
-    // Measured means (eq. 9 / gradient): edges 0.0173 / 0.0153, corners 0.0290 / 0.0261,
-    // sphere discs 0.0155 / 0.0145 (the README quotes them).
-    check_family(Family::Edges, 0.0185, 0.0165, 0.3);
-    check_family(Family::Corners, 0.031, 0.028, 0.5);
-    check_family(Family::SphereDiscs, 0.0165, 0.0155, 0.3);
+    // Measured means (eq. 9 / gradient): edges 0.0173 / 0.0063, corners 0.0290 / 0.0125,
+    // sphere discs 0.0155 / 0.0089; largest gradient errors 0.17, 0.22, 0.17 (the README
+    // quotes the means).
+    check_family(Family::Edges, 0.0185, 0.0075, 0.2);
+    check_family(Family::Corners, 0.031, 0.0145, 0.3);
+    check_family(Family::SphereDiscs, 0.0165, 0.0105, 0.2);
 }
 
 /// The closed form of a cap clipped to the hemisphere against the polar integral, and the
@@ -434,8 +435,82 @@ fn eval_good_and_bad_lines() {
     assert_eq!(errs, 1);
 }
 
+/// The straight-edge variant's line in `f64`, written from the description in the
+/// `rsl::vdt` module docs (not from its code): the 4 × 4 stencil of centres (offsets
+/// `−1, 0, +1, +2` from the cell, or `−3, −1, +2, +4` for `r ≥ 4.5`, clamped to the table),
+/// the least-squares plane through the samples, the zero level corrected by `c(|D|)` for
+/// the raw plane's normal, and the least-squares plane through the corrected samples:
+/// `(d, gx, gy)` at `(u, v)`.
+fn reference_line(w: usize, h: usize, d: &[f64], u: f64, v: f64, r: f64) -> (f64, f64, f64) {
+    let wide = r >= 4.5;
+    let axis = |x: f64, len: usize| -> (Vec<usize>, Vec<f64>) {
+        let x = x.clamp(0.0, len as f64);
+        let i0 = ((x - 0.5).floor().max(0.0) as usize).min(len.saturating_sub(2));
+        let offs: [i64; 4] = if wide { [-3, -1, 2, 4] } else { [-1, 0, 1, 2] };
+        let idx: Vec<usize> = offs
+            .iter()
+            .map(|&o| (i0 as i64 + o).clamp(0, len as i64 - 1) as usize)
+            .collect();
+        let pos = idx.iter().map(|&k| k as f64 + 0.5 - x).collect();
+        (idx, pos)
+    };
+    let (ix, px) = axis(u, w);
+    let (jy, py) = axis(v, h);
+    let samples: Vec<Vec<f64>> = jy
+        .iter()
+        .map(|&j| ix.iter().map(|&i| d[j * w + i]).collect())
+        .collect();
+    // Least squares over the grid: the normal equations of a + gx·x + gy·y separate because
+    // the grid is a tensor product (centre the coordinates).
+    let plane = |z: &Vec<Vec<f64>>| -> (f64, f64, f64) {
+        let mx = px.iter().sum::<f64>() / 4.0;
+        let my = py.iter().sum::<f64>() / 4.0;
+        let mean = z.iter().flatten().sum::<f64>() / 16.0;
+        let (mut sxx, mut syy, mut sxz, mut syz) = (0.0, 0.0, 0.0, 0.0);
+        for (b, row) in z.iter().enumerate() {
+            for (a, &val) in row.iter().enumerate() {
+                let (dx, dy) = (px[a] - mx, py[b] - my);
+                sxx += dx * dx;
+                syy += dy * dy;
+                sxz += dx * (val - mean);
+                syz += dy * (val - mean);
+            }
+        }
+        let gx = if sxx > 0.0 { sxz / sxx } else { 0.0 };
+        let gy = if syy > 0.0 { syz / syy } else { 0.0 };
+        (mean - gx * mx - gy * my, gx, gy)
+    };
+    let (_, gx, gy) = plane(&samples);
+    let l = gx.hypot(gy);
+    let (p, m) = if l > 0.0 {
+        let (a, b) = ((gx / l).abs(), (gy / l).abs());
+        (a.min(b), a.max(b))
+    } else {
+        (0.0, 1.0)
+    };
+    let corrected: Vec<Vec<f64>> = samples
+        .iter()
+        .map(|row| {
+            row.iter()
+                .map(|&x| {
+                    let c = if x.abs() < 0.6 {
+                        m / 2.0 - 0.5
+                    } else if x.abs() < 1.1 {
+                        m + p / 2.0 - 0.5f64.sqrt()
+                    } else {
+                        1.6 * p * (1.0 - p)
+                    };
+                    x + x.signum() * c
+                })
+                .collect()
+        })
+        .collect();
+    plane(&corrected)
+}
+
 /// `eval vdt-box` on random grids it never saw, against an independent f64 evaluation from
-/// the brute-force distances (bilinear D, gradient normal, polygon clipping).
+/// the brute-force distances: eq. 9 on the bilinear D, and the straight-edge variant's
+/// line ([`reference_line`]) cut against the square by polygon clipping.
 #[test]
 fn eval_matches_independent_reference() {
     let mut rng = Rng::new(99);
@@ -455,13 +530,17 @@ fn eval_matches_independent_reference() {
                 [
                     rng.range(0.5, w as f64 - 0.5) as f32 as f64,
                     rng.range(0.5, h as f64 - 0.5) as f32 as f64,
-                    rng.log_range(0.1, 5.0) as f32 as f64,
+                    rng.log_range(0.1, 8.0) as f32 as f64,
                 ]
             })
             .collect();
         let line = serde_json::json!({"mask": rows, "queries": qs}).to_string();
         let out = eval_vdt_box(&line).unwrap();
-        let d = brute_force_edges(w, h, &m);
+        // The f32 table, as the kernel reads it, widened.
+        let d: Vec<f64> = brute_force_edges(w, h, &m)
+            .into_iter()
+            .map(f64::from)
+            .collect();
         for (k, q) in qs.iter().enumerate() {
             let (x, y) = (q[0] - 0.5, q[1] - 0.5);
             let (i0, j0) = (
@@ -469,16 +548,15 @@ fn eval_matches_independent_reference() {
                 (y.floor() as usize).min(h - 2),
             );
             let (fx, fy) = (x - i0 as f64, y - j0 as f64);
-            let s = |i: usize, j: usize| d[j * w + i] as f64;
+            let s = |i: usize, j: usize| d[j * w + i];
             let (d00, d10, d01, d11) = (s(i0, j0), s(i0 + 1, j0), s(i0, j0 + 1), s(i0 + 1, j0 + 1));
             let dd =
                 (1.0 - fy) * ((1.0 - fx) * d00 + fx * d10) + fy * ((1.0 - fx) * d01 + fx * d11);
-            let gx = (1.0 - fy) * (d10 - d00) + fy * (d11 - d01);
-            let gy = (1.0 - fx) * (d01 - d00) + fx * (d11 - d10);
             let r = q[2];
             // Eq. 9: ½ + D/(√2·r), the side √2·r cut at distance D parallel to a side.
             let e9 = (0.5 + dd / (2f64.sqrt() * r)).clamp(0.0, 1.0);
             let hs = r / 2f64.sqrt();
+            let (dl, gx, gy) = reference_line(w, h, &d, q[0], q[1], r);
             let (nx, ny) = if gx == 0.0 && gy == 0.0 {
                 (1.0, 0.0)
             } else {
@@ -486,12 +564,15 @@ fn eval_matches_independent_reference() {
                 (gx / l, gy / l)
             };
             let sq = [[-hs, -hs], [hs, -hs], [hs, hs], [-hs, hs]];
-            let gr = polygon_area(&clip(&sq, [nx, ny], -dd)) / (4.0 * hs * hs);
+            let gr = polygon_area(&clip(&sq, [nx, ny], -dl)) / (4.0 * hs * hs);
             let got9 = out["values"][k].as_f64().unwrap();
             let gotg = out["values_gradient"][k].as_f64().unwrap();
-            let tol = 2e-6 * (1.0 + dd.abs() / hs);
-            assert!((got9 - e9).abs() < tol, "eq9 {q:?}: {got9} vs {e9}");
-            assert!((gotg - gr).abs() < tol, "gradient {q:?}: {gotg} vs {gr}");
+            let tol9 = 2e-6 * (1.0 + dd.abs() / hs);
+            // The line's f32 rounding (two planes over 16 samples) moves it by a few ulps of
+            // the samples' magnitude: relative to the half-side.
+            let tolg = 2e-6 * (1.0 + (dl.abs() + 8.0) / hs);
+            assert!((got9 - e9).abs() < tol9, "eq9 {q:?}: {got9} vs {e9}");
+            assert!((gotg - gr).abs() < tolg, "gradient {q:?}: {gotg} vs {gr}");
         }
     }
 }
@@ -528,9 +609,8 @@ fn report_section() {
 
 /// On oblique straight edges (`|sin 2θ| ≥ ½`, `r ∈ [4, 12]`) the straight-edge variant's
 /// mean error against the exact coverage, over that of eq. 9 fed the exact distance to the
-/// edge line. Measured 1.39 (gradient 0.0242, eq. 9 on the exact distance 0.0174): with the
-/// geometric eq. 9 an exact distance beats the staircase's distance and in-cell slope; the
-/// guard keeps the figure from getting worse.
+/// edge line: the goal is at most 0.45. (With the bilinear distance and its in-cell slope as
+/// the line, the ratio was 1.39: the staircase's distance is biased toward the texels.)
 #[test]
 fn gradient_variant_against_exact_distance_eq9_on_oblique_edges() {
     let (g, e9) = steradian_harness::vdt::oblique_edges(0x0b1e, 60, 40);
@@ -539,6 +619,5 @@ fn gradient_variant_against_exact_distance_eq9_on_oblique_edges() {
         "oblique edges: gradient {g:.4e}, eq. 9 on the exact distance {e9:.4e}, ratio {ratio:.3}"
     );
     assert!((0.016..0.019).contains(&e9), "{e9}");
-    assert!((0.022..0.026).contains(&g), "{g}");
-    assert!(ratio < 1.45, "{ratio}");
+    assert!(ratio < 0.45, "{ratio}");
 }

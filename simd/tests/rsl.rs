@@ -12,7 +12,7 @@ use steradian_core::rsl::Rsl;
 use steradian_core::rsl::brdf_sat::{BrdfSat, Resolution};
 use steradian_core::rsl::sat::{Sat, SatView};
 use steradian_core::rsl::shade::{self as core_shade, ShadeLight, VdtQuery, VdtVisibility};
-use steradian_core::rsl::vdt::{Vdt, VdtView};
+use steradian_core::rsl::vdt::{FIT_WIDE_R, R_MAX, R_MIN, Vdt, VdtView};
 use steradian_core::rsl::vis_moments::VisMoments;
 use steradian_simd::rsl::shade::{
     IsoBrdfTables, MOMENTS_REL_TOL, MomentsInput, REL_TOL, ShadeInput, shade_moments_x8, shade_x8,
@@ -152,15 +152,84 @@ fn sat_integer_corner_path_and_spoiled_lanes() {
 
 // ---- VDT ------------------------------------------------------------------------------
 
-/// The table of a disc of occluded texels (centre `(cx, cy)`, radius `rad`, texel units).
-fn disc_vdt(w: usize, h: usize, cx: f32, cy: f32, rad: f32) -> Vdt {
+/// Table sizes of the VDT tests: those of the SAT tests and the small ones whose
+/// straight-edge stencils are clamped everywhere (1 × N, N × 1, 2 × 2, 3 × 5, 8 × 8).
+const VDT_SIZES: [(usize, usize); 11] = [
+    (1, 1),
+    (1, 2),
+    (2, 1),
+    (2, 2),
+    (1, 9),
+    (9, 1),
+    (3, 5),
+    (8, 8),
+    (17, 13),
+    (64, 64),
+    (300, 7),
+];
+
+/// Half-diagonals the VDT tests name: point queries (`r ≤ 0`), the clamps to
+/// `[R_MIN, R_MAX]`, and the switch to the wide stencil at `FIT_WIDE_R` with its neighbours.
+const NAMED_RADII: [f32; 12] = [
+    0.0,
+    -0.0,
+    -1.0,
+    R_MIN,
+    0.5 * R_MIN,
+    R_MAX,
+    2.0 * R_MAX,
+    FIT_WIDE_R,
+    FIT_WIDE_R.next_down(),
+    FIT_WIDE_R.next_up(),
+    4.0,
+    5.0,
+];
+
+/// A half-diagonal: a special value or a named one one time in eight each, else uniform
+/// over `[0, 12)` (both stencils).
+fn radius(rng: &mut Rng) -> f32 {
+    match rng.next_u64() % 8 {
+        0 => special(rng),
+        1 => NAMED_RADII[(rng.next_u64() % NAMED_RADII.len() as u64) as usize],
+        _ => rng.range(0.0, 12.0),
+    }
+}
+
+/// The table of a mask, `visible(x, y)` at the texel centres.
+fn mask_vdt(w: usize, h: usize, visible: impl Fn(f32, f32) -> bool) -> Vdt {
     let mask: Vec<bool> = (0..w * h)
-        .map(|k| {
-            let (x, y) = ((k % w) as f32 + 0.5 - cx, (k / w) as f32 + 0.5 - cy);
-            x * x + y * y > rad * rad
-        })
+        .map(|k| visible((k % w) as f32 + 0.5, (k / w) as f32 + 0.5))
         .collect();
     Vdt::build(w, h, &mask).expect("valid shape")
+}
+
+/// The table of a disc of occluded texels (centre `(cx, cy)`, radius `rad`, texel units).
+fn disc_vdt(w: usize, h: usize, cx: f32, cy: f32, rad: f32) -> Vdt {
+    mask_vdt(w, h, |x, y| {
+        let (x, y) = (x - cx, y - cy);
+        x * x + y * y > rad * rad
+    })
+}
+
+/// The tables of the VDT tests on a `w × h` grid: a disc, no boundary (all visible, all
+/// occluded), axis-aligned half-planes along each axis (slope exactly 0 along the other),
+/// an oblique one, random texels.
+fn vdt_tables(w: usize, h: usize, rng: &mut Rng) -> Vec<Vdt> {
+    let (wf, hf) = (w as f32, h as f32);
+    let bits: Vec<bool> = (0..w * h)
+        .map(|_| rng.next_u64().is_multiple_of(2))
+        .collect();
+    vec![
+        disc_vdt(w, h, 0.4 * wf, 0.6 * hf, 0.3 * wf.min(hf) + 0.5),
+        mask_vdt(w, h, |_, _| true),
+        mask_vdt(w, h, |_, _| false),
+        mask_vdt(w, h, |x, _| x > 0.5 * wf),
+        mask_vdt(w, h, |_, y| y < 0.4 * hf),
+        mask_vdt(w, h, |x, y| {
+            0.8 * (x - 0.5 * wf) + 0.6 * (y - 0.3 * hf) > 0.0
+        }),
+        Vdt::build(w, h, &bits).expect("valid shape"),
+    ]
 }
 
 /// `query_slices` against `VdtView::query`, both estimates bit for bit.
@@ -178,38 +247,79 @@ fn check_vdt(v: &VdtView<'_>, rows: &[[f32; 3]]) {
 #[test]
 fn vdt_random_queries_at_every_length() {
     let mut rng = Rng(91);
-    for (w, h) in SIZES {
-        let t = disc_vdt(
-            w,
-            h,
-            0.4 * w as f32,
-            0.6 * h as f32,
-            0.3 * w.min(h) as f32 + 0.5,
-        );
-        for len in LENGTHS {
-            let rows: Vec<[f32; 3]> = (0..len)
-                .map(|_| {
-                    let r = if rng.next_u64().is_multiple_of(8) {
-                        special(&mut rng)
-                    } else {
-                        rng.range(0.0, 8.0)
-                    };
-                    [coord(&mut rng, w), coord(&mut rng, h), r]
-                })
-                .collect();
+    for (w, h) in VDT_SIZES {
+        for t in vdt_tables(w, h, &mut rng) {
+            for len in LENGTHS {
+                let rows: Vec<[f32; 3]> = (0..len)
+                    .map(|_| {
+                        let r = radius(&mut rng);
+                        [coord(&mut rng, w), coord(&mut rng, h), r]
+                    })
+                    .collect();
+                check_vdt(&t.view(), &rows);
+            }
+        }
+    }
+}
+
+/// A grid of centres over and beyond the table (every quarter texel on small tables: on
+/// the texel centres and edges where the cell and the stencil change, and past both ends
+/// where they clamp), each with half-diagonals of both stencils and around the switch.
+#[test]
+fn vdt_grid_over_and_beyond_the_edges() {
+    let mut rng = Rng(92);
+    let radii = [
+        0.0,
+        0.3,
+        1.0,
+        3.0,
+        FIT_WIDE_R.next_down(),
+        FIT_WIDE_R,
+        9.0,
+        40.0,
+    ];
+    let steps = |n: usize| -> Vec<f32> {
+        let step = (0.25f32).max(((n + 4) as f32 / 48.0).ceil() * 0.25);
+        let k = ((n as f32 + 4.0) / step) as usize;
+        (0..=k).map(|i| -2.0 + i as f32 * step).collect()
+    };
+    for (w, h) in VDT_SIZES {
+        let (us, vs) = (steps(w), steps(h));
+        let mut rows = Vec::new();
+        for &u in &us {
+            for &v in &vs {
+                rows.extend(radii.map(|r| [u, v, r]));
+            }
+        }
+        for t in vdt_tables(w, h, &mut rng) {
             check_vdt(&t.view(), &rows);
         }
     }
 }
 
+/// Special values in each of `u`, `v` and `r` (and the named half-diagonals, at the centre
+/// and on the edges of the table) in every lane position, on tables of every shape.
 #[test]
 fn vdt_special_values_in_every_lane() {
-    let t = disc_vdt(32, 32, 14.0, 17.0, 7.0);
-    let rows: Vec<[f32; 3]> = SPECIALS
-        .iter()
-        .flat_map(|&x| [[x, 16.0, 3.0], [16.0, x, 3.0], [16.0, 16.0, x]])
-        .collect();
-    in_every_lane(&rows, [10.0, 10.0, 2.0], |r| check_vdt(&t.view(), r));
+    let mut rng = Rng(93);
+    let mut tables = vec![disc_vdt(32, 32, 14.0, 17.0, 7.0)];
+    for (w, h) in [(1, 1), (2, 2), (1, 9), (9, 1), (5, 5)] {
+        tables.extend(vdt_tables(w, h, &mut rng));
+    }
+    for t in &tables {
+        let (w, h) = (t.width() as f32, t.height() as f32);
+        let (cu, cv) = (0.5 * w, 0.5 * h);
+        let mut rows: Vec<[f32; 3]> = SPECIALS
+            .iter()
+            .flat_map(|&x| [[x, cv, 3.0], [cu, x, 3.0], [cu, cv, x], [x, x, 6.0]])
+            .collect();
+        for r in NAMED_RADII {
+            for (u, v) in [(cu, cv), (0.0, 0.0), (w, h), (-0.5, cv), (cu, h + 0.5)] {
+                rows.push([u, v, r]);
+            }
+        }
+        in_every_lane(&rows, [cu, cv, 2.0], |r| check_vdt(&t.view(), r));
+    }
 }
 
 // ---- Shading (eq. 5 and the moments kernel) ---------------------------------------------
@@ -409,6 +519,26 @@ fn shade_special_views_in_every_lane() {
             check_shade(&s, &pts, VdtQuery::Eq9);
             check_moments(&s, &pts, &s.lights);
         }
+    }
+}
+
+/// The eq. 5 kernel with VDTs of 1 × 1, 2 × 2 and 5 × 5 texels (every straight-edge
+/// stencil clamped), with and without a boundary, a different table in each lane, both
+/// queries.
+#[test]
+fn shade_small_and_uniform_vdts() {
+    let mut s = setup(true);
+    let mut rng = Rng(20);
+    for n in [1usize, 2, 5] {
+        let tables = vdt_tables(n, n, &mut rng);
+        s.vdts = (0..8).map(|k| tables[k % tables.len()].clone()).collect();
+        let mut lit = 0;
+        for _ in 0..16 {
+            let pts = points(&mut rng, None);
+            lit += check_shade(&s, &pts, VdtQuery::Eq9);
+            lit += check_shade(&s, &pts, VdtQuery::Gradient);
+        }
+        assert!(lit > 0, "n {n}: nothing lit");
     }
 }
 

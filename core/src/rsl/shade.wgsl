@@ -12,14 +12,13 @@ fn vdt_table(at: u32) -> f32 {
     return tf(at);
 }
 
-// Visible fraction from the n×n VDT at word `base`, by eq. 9 or the gradient variant.
+// Visible fraction from the n×n VDT at word `base`, by eq. 9 or the straight-edge variant
+// (`shade::VdtVisibility`).
 fn vdt_fraction(base: u32, n: u32, u: f32, v: f32, r: f32, gradient: bool) -> f32 {
-    let c = vdt_cell(base, n, n, u, v);
-    let d = vdt_distance(c);
     if (!gradient) {
-        return vdt_eq9(d, r);
+        return vdt_eq9(vdt_distance(vdt_cell(base, n, n, u, v)), r);
     }
-    return vdt_edge(d, vdt_gradient(c), r);
+    return vdt_straight_edge(base, n, n, u, v, r);
 }
 
 @compute @workgroup_size(64)

@@ -4,7 +4,7 @@
 //! batch layout below is written once, in `wgsl/batch.wgsl`, and prepended to every source,
 //! so each constant is a complete shader. Functions that several kernels use are written
 //! once too and concatenated into each of them: `wgsl/log1p.wgsl` (`log` without WGSL's
-//! `log`), `wgsl/sat_lib.wgsl` (SAT box sums) and `wgsl/vdt_lib.wgsl` (VDT queries).
+//! `log`), `rsl/sat_lib.wgsl` (SAT box sums) and `rsl/vdt_lib.wgsl` (VDT queries).
 //!
 //! ## Bindings (identical for every kernel)
 //!
@@ -156,18 +156,33 @@ pub const SAT_BOX_REL_TOL: f32 = 1.0e-6;
 /// Visibility distance table query (`vdt::VdtView::query`): input columns `[u, v, r]`
 /// (centre and half-diagonal in texel units), output `[eq9, gradient]`. Binding 3 is the
 /// table `[w, h, D…]` of `vdt::Vdt::gpu_table` (`w`, `h` as `f32`, samples row-major). Not
-/// in [`ALL`] (no built-in table): run it with the harness's custom kernels. Same
-/// operations as the scalar kernel (bilinear `(1 − t)·a + t·b`, in-cell gradient, eq. 9,
-/// straight-edge fraction). Tolerance: [`VDT_QUERY_TOL`].
+/// in [`ALL`] (no built-in table): run it with the harness's custom kernels. Eq. 9 of the
+/// bilinear `D` (`(1 − t)·a + t·b`), and the straight-edge variant: the 4 × 4 stencil
+/// (narrow below `vdt::FIT_WIDE_R`, wide from it, indices clamped in `f32` before they
+/// become `u32`), the least-squares plane through the raw samples, the zero-level
+/// correction, the plane through the corrected samples and the exact fraction of the square
+/// on the visible side of that line (`vdt::VdtView::gradient`). The same operations in the
+/// same order as the scalar kernel (`sum4`'s pairing, `select` for its branches), in
+/// `rsl/vdt_lib.wgsl`, which [`SHADE`] shares. Tolerance: [`VDT_QUERY_TOL`].
 pub const VDT_QUERY: &str = concat!(
     include_str!("batch.wgsl"),
     include_str!("../rsl/vdt_lib.wgsl"),
     include_str!("../rsl/vdt.wgsl")
 );
-/// Difference allowed between [`VDT_QUERY`] and `vdt::VdtView::query` per output, in units
-/// of `1 + |t|` with `t = D·√2/r` the distance in half-sides (WGSL division is 2.5 ulp and a
-/// compiler may fuse the bilinear `a·b + c`, which moves `D` by ulps that the ramp divides
-/// by the half-side). Lavapipe: bit-identical (harness test `tests/vdt_gpu.rs`).
+/// Difference allowed between [`VDT_QUERY`] and `vdt::VdtView::query` per output: eq. 9 in
+/// units of `1 + |t|` with `t = D·√2/r` the bilinear `D` in half-sides, the straight-edge
+/// fraction in units of `1 + |t| + s` with `t` the fitted line's distance in half-sides and
+/// `s = S·√2/r`, `S` the largest `|D|` among the stencil's 16 samples (the fitted distance
+/// rounds at the samples' magnitude, which the fraction divides by the half-side; WGSL
+/// division is 2.5 ulp and a compiler may fuse `a·b + c` or reassociate sums). Lavapipe:
+/// eq. 9 bit-identical; the straight-edge fraction differs in up to 8 % of the queries on
+/// maps with a boundary (the driver reassociates or contracts the fit's sums: the mean of
+/// the 16 samples, for one, comes out as the sum of the row sums, not of the column sums),
+/// by at most `9.5e-8` in these units, about one ulp of the fraction (harness test
+/// `tests/vdt_gpu.rs`, which prints both figures, over 16 maps from 1 × 1 to 64 × 64 with
+/// queries along the edges and `r` on both sides of `vdt::FIT_WIDE_R`). Set at 20 times
+/// that figure, the headroom the eq. 9 kernel has always had: WGSL division may be 2.5 ulp
+/// off, and lavapipe's own code generation follows the host CPU's vector extensions.
 pub const VDT_QUERY_TOL: f32 = 2.0e-6;
 
 /// Control-point query (`cp::Icosphere::query`): input columns `[x, y, z]` (any non-zero
@@ -288,8 +303,9 @@ pub const SH_IRRADIANCE_TOL: f32 = 1.0e-5;
 /// E_g, E_b]`, per BRDF table (polar node `k`) its exponent word and its `i64` entries as
 /// in `sat::SatView::gpu_words`, and per point `vdt_n²` `f32` distances. The harness's
 /// `shade::gpu_table` builds it. Same operations as the scalar kernel except the SAT
-/// combination in `f32` (as [`SAT_BOX`]) and the map without the overflow-safe rescaling.
-/// Tolerance: [`SHADE_REL_TOL`].
+/// combination in `f32` (as [`SAT_BOX`]) and the map without the overflow-safe rescaling;
+/// the visibility is [`VDT_QUERY`]'s eq. 9 or straight-edge query (the shared
+/// `rsl/vdt_lib.wgsl`, `shade::VdtVisibility`). Tolerance: [`SHADE_REL_TOL`].
 pub const SHADE: &str = concat!(
     include_str!("batch.wgsl"),
     include_str!("../rsl/sat_lib.wgsl"),
@@ -299,8 +315,11 @@ pub const SHADE: &str = concat!(
 );
 /// Difference allowed between [`SHADE`] and `shade::shade`, per channel, relative to the
 /// point's largest channel (the `f32` SAT combination is within about `10⁻⁶` of the
-/// table's local magnitude; a VDT edge query moves by ulps of the square's coordinates over
-/// its half-side).
+/// table's local magnitude; a VDT query moves by ulps of the square's coordinates over its
+/// half-side). Lavapipe: `2.0e-6` with eq. 9 (its VDT queries bit-identical: the SAT's
+/// share) and `2.0e-6` with the straight-edge query, over Lambert and Phong (harness test
+/// `tests/shade.rs`, `gpu_matches_scalar`, which prints them); set at 50 times that (the
+/// bound it always had), for adapters other than lavapipe on this CPU.
 pub const SHADE_REL_TOL: f32 = 1.0e-4;
 
 /// RSL shading with visibility moments, one point per invocation

@@ -4,7 +4,11 @@
 //! Each lane is one shading point; the loop runs over the lights. Per light and lane: the
 //! rotation of the light's centre into the lane's frame, the extended equal-area map, the
 //! horizon cull, the two view-interpolated BRDF SAT square queries and the VDT query, all
-//! lane-wise; only the table reads are scalar (`wide` has no gather). The two BRDF tables
+//! lane-wise; only the table reads are scalar (`wide` has no gather). The VDT query is
+//! `VdtVisibility::fraction` operation for operation (the square in texel units, then eq. 9
+//! of the bilinear `D`, or for `VdtQuery::Gradient` the straight-edge fraction of the
+//! fitted 4 × 4 stencil, [`crate::rsl::vdt`]'s lane code): bit-identical to the scalar
+//! query of the same square, each lane reading its own table. The two BRDF tables
 //! between which a point's view is interpolated are read at the **same** indices (the square
 //! is the same), so the corner arithmetic is done once for both (the scalar kernel repeats
 //! it per table). Exact integer arithmetic of the SAT (`i64x8`) and the `f64x8` combination
@@ -25,7 +29,6 @@
 
 use glam::Vec3;
 use steradian_core::frame::Frame;
-use steradian_core::grid::Q_MIN;
 use steradian_core::rsl::sat::SatView;
 use steradian_core::rsl::shade::{ShadeLight, VdtQuery};
 use steradian_core::rsl::vdt::{R_MAX, R_MIN, VdtView};
@@ -194,27 +197,9 @@ fn box_pair_f64(
     (one(&g[0], quanta[0]), one(&g[1], quanta[1]))
 }
 
-/// The straight-edge fraction (`steradian_core::grid::square_halfplane_fraction` after the
-/// reduction of the normal to `q`), lane-wise.
-#[inline(always)]
-fn edge_fraction(t: f32x8, q: f32x8) -> f32x8 {
-    let one = f32x8::ONE;
-    let len = (one + q * q).sqrt();
-    let hi = one + q;
-    let tt = t * len;
-    let tt = sel(tt.simd_gt(hi), hi, sel(tt.simd_lt(-hi), -hi, tt));
-    let qm = f32x8::splat(Q_MIN);
-    let den = f32x8::splat(8.0) * sel(q.simd_gt(qm), q, qm);
-    let lo_e = tt + hi;
-    let lo_v = lo_e * lo_e / den;
-    let hi_e = hi - tt;
-    let hi_v = one - hi_e * hi_e / den;
-    let mid = (tt + one) * f32x8::splat(0.5);
-    let r = sel(tt.simd_ge(one - q), hi_v, mid);
-    sel(tt.simd_le(q - one), lo_v, r)
-}
-
-/// VDT visible fractions per lane for squares `(u, v, r)` in texel units.
+/// VDT visible fractions per lane for squares `(u, v, r)` in texel units (lane `k` reads
+/// `vdts[k]`, all `n × n`): eq. 9 of the bilinear `D`, or the straight-edge fraction of the
+/// fitted line, [`crate::rsl::vdt`]'s lane code (bit-identical to `VdtView::gradient`).
 #[inline(always)]
 fn vdt_lanes(
     vdts: &[VdtView<'_>; 8],
@@ -224,6 +209,9 @@ fn vdt_lanes(
     r: f32x8,
     query: VdtQuery,
 ) -> f32x8 {
+    if query == VdtQuery::Gradient {
+        return crate::rsl::vdt::gradient_lanes(|k| vdts[k].samples(), n, n, [u, v, r]);
+    }
     let hi_index = f32x8::splat(if n >= 2 { (n - 2) as f32 } else { 0.0 });
     let hi_frac = f32x8::splat(if n >= 2 { 1.0 } else { 0.0 });
     let zero = f32x8::ZERO;
@@ -261,18 +249,28 @@ fn vdt_lanes(
     let dd = lerp(d0, d1, fy);
     let (rmin, rmax) = (f32x8::splat(R_MIN), f32x8::splat(R_MAX));
     let rr = sel(r.simd_lt(rmin), rmin, sel(r.simd_gt(rmax), rmax, r));
-    let sqrt2 = f32x8::splat(core::f32::consts::SQRT_2);
-    match query {
-        VdtQuery::Eq9 => crate::rsl::vdt::eq9_lanes(dd, rr),
-        VdtQuery::Gradient => {
-            let gx = lerp(d10 - d00, d11 - d01, fy).abs();
-            let gy = lerp(d01 - d00, d11 - d10, fx).abs();
-            let m = sel(gx.simd_gt(gy), gx, gy);
-            let mn = sel(gx.simd_lt(gy), gx, gy);
-            let q = sel(m.simd_gt(zero), mn / m, zero);
-            edge_fraction(dd * sqrt2 / rr, q)
-        }
-    }
+    crate::rsl::vdt::eq9_lanes(dd, rr)
+}
+
+/// `VdtVisibility::fraction` lane-wise for the disk-unit squares `(px, py, r)`: the square
+/// in texel units (`(p + 1)·n/2`, `r·n/2`, the scalar operations), then [`vdt_lanes`].
+#[inline(always)]
+fn vdt_fraction(
+    vdts: &[VdtView<'_>; 8],
+    n: usize,
+    (px, py, r): (f32x8, f32x8, f32x8),
+    query: VdtQuery,
+) -> f32x8 {
+    let half_n = f32x8::splat(0.5 * n as f32);
+    let one = f32x8::ONE;
+    vdt_lanes(
+        vdts,
+        n,
+        (px + one) * half_n,
+        (py + one) * half_n,
+        r * half_n,
+        query,
+    )
 }
 
 /// The per-lane state both kernels share: the frames as rows, the view's table constants,
@@ -396,8 +394,6 @@ pub fn shade_x8(
     let lanes = PointLanes::new(points.map(|p| p.frame), points.map(|p| p.wo), brdf);
     let vdts: [VdtView<'_>; 8] = core::array::from_fn(|k| points[k].vdt);
     let half_b = f32x8::splat(0.5 * bw as f32);
-    let half_v = f32x8::splat(0.5 * n as f32);
-    let one = f32x8::ONE;
     let mut acc = [f32x8::ZERO; 3];
     for l in lights {
         let r = f32x8::splat(l.half_diagonal());
@@ -416,14 +412,7 @@ pub fn shade_x8(
             bh,
         );
         let rho = (v0 + lanes.tw * (v1 - v0)) * f32x8::splat(l.inv_solid_angle());
-        let vis = vdt_lanes(
-            &vdts,
-            n,
-            (px + one) * half_v,
-            (py + one) * half_v,
-            r * half_v,
-            query,
-        );
+        let vis = vdt_fraction(&vdts, n, (px, py, r), query);
         let f = sel(live, rho * vis, f32x8::ZERO) + lanes.nan;
         for (a, e) in acc.iter_mut().zip(l.energy()) {
             *a += f32x8::splat(e) * f;
@@ -728,4 +717,125 @@ pub fn shade_batch(
     out: &mut [[f32; 3]],
 ) -> bool {
     by_eight(points, out, |g| shade_x8(g, brdf, query, lights))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::lanes::tests::same;
+    use glam::Vec2;
+    use steradian_core::rsl::shade::{SquareVisibility, VdtVisibility};
+    use steradian_core::rsl::vdt::{FIT_WIDE_R, scratch_len, signed_distance_into};
+
+    /// The exact table of an `n × n` mask.
+    fn table(n: usize, mask: &[bool]) -> Vec<f32> {
+        let mut d = vec![0.0; n * n];
+        let mut s = vec![0.0; scratch_len(n, n)];
+        signed_distance_into(n, n, mask, &mut d, &mut s).unwrap();
+        d
+    }
+
+    /// `vdt_fraction` (the VDT step of `shade_x8`) against `VdtVisibility::fraction` (the
+    /// scalar shading kernel's), both queries, bit for bit: eight different tables per size
+    /// (random, half-planes axis-aligned and oblique, a disc, no boundary either way), random
+    /// squares over and beyond the parametrisation square, and special values in `p` and `r`
+    /// (NaN, ±∞, zeros, huge, the half-diagonals around `FIT_WIDE_R`) in every lane.
+    #[test]
+    fn vdt_fraction_matches_vdt_visibility_bit_for_bit() {
+        let mut s = 0x5eed_u64;
+        let mut next = || {
+            s = s
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (s >> 40) as f32 / (1u64 << 24) as f32
+        };
+        let specials = [
+            f32::NAN,
+            f32::INFINITY,
+            f32::NEG_INFINITY,
+            0.0,
+            -0.0,
+            1e-40,
+            -1.0,
+            1.0,
+            -1e30,
+            1e30,
+            0.999_999_9,
+        ];
+        for n in [1usize, 2, 3, 4, 8, 13] {
+            let half_n = 0.5 * n as f32;
+            let masks: Vec<Vec<bool>> = (0..8)
+                .map(|t| {
+                    (0..n * n)
+                        .map(|k| {
+                            let (x, y) = ((k % n) as f32 + 0.5, (k / n) as f32 + 0.5);
+                            let c = 0.5 * n as f32;
+                            match t {
+                                0 => true,
+                                1 => false,
+                                2 => x < c,
+                                3 => y >= 0.3 * n as f32,
+                                4 => 0.6 * x - 0.8 * y + 0.2 * c > 0.0,
+                                5 => (x - c) * (x - c) + (y - 0.4 * c) * (y - 0.4 * c) > c,
+                                _ => next() < 0.5,
+                            }
+                        })
+                        .collect()
+                })
+                .collect();
+            let tables: Vec<Vec<f32>> = masks.iter().map(|m| table(n, m)).collect();
+            let views: [VdtView<'_>; 8] =
+                core::array::from_fn(|k| VdtView::new(n, n, &tables[k]).unwrap());
+            // Disk-unit half-diagonals whose texel half-diagonal is FIT_WIDE_R and its
+            // neighbours (exact for power-of-two sides).
+            let wide = FIT_WIDE_R / half_n;
+            let radii = [
+                wide,
+                wide.next_down(),
+                wide.next_up(),
+                0.0,
+                -1.0,
+                1e-14,
+                1e30,
+            ];
+            let mut rows: Vec<[f32; 3]> = Vec::new();
+            for _ in 0..400 {
+                let r = if next() < 0.3 {
+                    radii[(next() * radii.len() as f32) as usize % radii.len()]
+                } else {
+                    (next() * 1.5).powi(2)
+                };
+                rows.push([next() * 2.8 - 1.4, next() * 2.8 - 1.4, r]);
+            }
+            for &x in specials.iter().chain(&radii) {
+                rows.extend([[x, 0.1, 0.3], [-0.2, x, 0.3], [0.1, -0.3, x]]);
+            }
+            // Every row in every lane position: shift by 0..8 filler rows.
+            for shift in 0..8 {
+                let mut r = vec![[0.25f32, -0.5, 0.2]; shift];
+                r.extend_from_slice(&rows);
+                for chunk in r.chunks(8) {
+                    let lane = |c: usize| {
+                        f32x8::new(core::array::from_fn(|k| {
+                            chunk.get(k).map_or(0.5, |row| row[c])
+                        }))
+                    };
+                    let (px, py, rr) = (lane(0), lane(1), lane(2));
+                    for query in [VdtQuery::Eq9, VdtQuery::Gradient] {
+                        let got = vdt_fraction(&views, n, (px, py, rr), query).to_array();
+                        for k in 0..8 {
+                            let (x, y, rk) = (px.as_array()[k], py.as_array()[k], rr.as_array()[k]);
+                            let vis = VdtVisibility::new(views[k], query).unwrap();
+                            let want = vis.fraction(Vec2::new(x, y), rk);
+                            assert!(
+                                same(got[k], want),
+                                "n {n} {query:?} lane {k} ({x}, {y}, {rk}): {} vs {want}",
+                                got[k]
+                            );
+                        }
+                    }
+                }
+            }
+        }
+    }
 }

@@ -2,21 +2,44 @@
 //! `steradian_core::rsl::vdt`).
 //!
 //! [`query`] performs exactly the operations of `steradian_core::rsl::vdt::VdtView::query` lane
-//! by lane: the clamped cell index and fraction per axis (`floor` written as `−ceil(−x)`,
-//! which is exact), the four samples, `lerp(a, b, t) = (1 − t)·a + t·b`, the in-cell
-//! gradient, eq. 9 and the straight-edge fraction with the scalar kernel's NaN-keeping
-//! clamps and NaN-ignoring `max`/`min`, and selects where the scalar kernel branches. All
-//! of them are correctly rounded IEEE operations, so every lane is **bit-identical** to the
-//! scalar query of that lane, for every input (NaN-ness matches). `wide` has no gather: the
-//! four samples of each lane are read by scalar indexing from the lanes' cell indices.
+//! by lane, so every lane is **bit-identical** to the scalar query of that lane, for every
+//! input (NaN-ness matches):
+//!
+//! - **Eq. 9** reads the four samples of the bilinear cell: the clamped cell index and
+//!   fraction per axis (`floor` written as `−ceil(−x)`, which is exact),
+//!   `lerp(a, b, t) = (1 − t)·a + t·b`, then `eq9_from`.
+//! - **The straight-edge fraction** reads the 16 samples of the scalar `VdtView::stencil`:
+//!   per axis the coordinate clamped to the table, the cell index of `axis`, the four centre
+//!   indices at offsets `−1, 0, +1, +2` (`−3, −1, +2, +4` in the lanes where
+//!   `r ≥ FIT_WIDE_R`; NaN `r` is narrow, as the scalar comparison is false) clamped to the
+//!   table, and their positions relative to the clamped coordinate, all computed lane-wise;
+//!   then `fit_stencil` (the least-squares plane through the raw samples, the zero-level
+//!   correction driven by its gradient, the plane through the corrected samples) and
+//!   `gradient_from` (`square_halfplane_fraction`).
+//!
+//! Bit-identity holds because every step is a correctly rounded IEEE operation (`+ − × ÷`,
+//! `sqrt`, `abs`, comparisons), done in the scalar kernel's order: the same `sum4` pairing
+//! `(a₀ + a₁) + (a₂ + a₃)`, the same `x − mean` deviations, no fused multiply–add (Rust
+//! never contracts, and neither does `wide`). The scalar kernel's branches (`if ss > 0`,
+//! `if hi > 0`, the `|D| < 0.6 / < 1.1` choice of the correction,
+//! `if x < 0 { x − c } else { x + c }`, the pieces of the half-plane fraction) become selects
+//! on the same comparisons, and `f32::clamp` (NaN kept) and `f32::max`/`min` (NaN ignored)
+//! have lane-wise spellings with the same NaN rules. `wide` has no gather: each lane's
+//! samples are read by scalar indexing from its lane-wise indices (one pass over the lanes,
+//! 4 reads for eq. 9 and 16 for the stencil), converted with the scalar kernel's `as usize`
+//! (saturating, NaN → 0), so the same texels are read.
+//!
+//! The straight-edge code is shared with the SIMD shading kernel ([`crate::rsl::shade`]),
+//! whose lanes may each read a different table of the same size.
 
 use steradian_core::grid::Q_MIN;
-use steradian_core::rsl::vdt::{R_MAX, R_MIN, VdtView};
+use steradian_core::rsl::vdt::{FIT_KAPPA, FIT_WIDE_R, R_MAX, R_MIN, VdtView};
 use wide::f32x8;
 
 use crate::lanes::{ColumnKernel, Lanes, SliceVec, clamp, drive, max_num, min_num};
 
 const SQRT_2: f32 = core::f32::consts::SQRT_2;
+const FRAC_1_SQRT_2: f32 = core::f32::consts::FRAC_1_SQRT_2;
 
 /// Per axis: the clamped cell index (as an exact `f32`) and fraction (scalar `vdt::axis`).
 #[inline(always)]
@@ -35,6 +58,12 @@ fn lerp<W: Lanes>(a: W, b: W, t: W) -> W {
     (W::splat(1.0) - t) * a + t * b
 }
 
+/// `r` clamped to `[R_MIN, R_MAX]`, NaN kept (scalar `vdt::clamp_r`).
+#[inline(always)]
+fn clamp_r<W: Lanes>(r: W) -> W {
+    clamp(r, W::splat(R_MIN), W::splat(R_MAX))
+}
+
 /// Eq. 9 lane-wise, `steradian_core::rsl::vdt::eq9_from` operation for operation, for a
 /// half-diagonal `rr` already clamped to `[R_MIN, R_MAX]` (the one copy the VDT query and
 /// the SIMD shading kernel share).
@@ -44,11 +73,171 @@ pub(crate) fn eq9_lanes<W: Lanes>(dd: W, rr: W) -> W {
     clamp((W::splat(0.5) * k + dd) / k, W::splat(0.0), W::splat(1.0))
 }
 
+/// `steradian_core::grid::square_halfplane_fraction(t, nx, ny)` lane-wise: the normal
+/// reduced to `q = min/max` of its absolute components, then the three pieces and the
+/// scalar kernel's choice between them as selects.
+#[inline(always)]
+fn halfplane_lanes<W: Lanes>(t: W, nx: W, ny: W) -> W {
+    let (zero, one) = (W::splat(0.0), W::splat(1.0));
+    let (ax, ay) = (nx.abs(), ny.abs());
+    let m = max_num(ax, ay);
+    let q = m.gt(zero).select(min_num(ax, ay) / m, zero);
+    let len = (one + q * q).sqrt();
+    let hi = one + q;
+    let tt = clamp(t * len, -hi, hi);
+    let den = W::splat(8.0) * max_num(q, W::splat(Q_MIN));
+    let lo_e = tt + hi;
+    let lo_v = lo_e * lo_e / den;
+    let hi_e = hi - tt;
+    let hi_v = one - hi_e * hi_e / den;
+    let mid = (tt + one) * W::splat(0.5);
+    let r = tt.ge(one - q).select(hi_v, mid);
+    tt.le(q - one).select(lo_v, r)
+}
+
+/// `(a₀ + a₁) + (a₂ + a₃)` (scalar `vdt::sum4`).
+#[inline(always)]
+fn sum4<W: Lanes>(a: [W; 4]) -> W {
+    (a[0] + a[1]) + (a[2] + a[3])
+}
+
+/// One axis of the straight-edge stencil lane-wise (scalar `vdt::stencil_axis`): the four
+/// centre indices (exact integers, or NaN) and their positions relative to the coordinate
+/// clamped to `[0, len]`. `wide` is a mask: the lanes reading offsets `−3, −1, +2, +4`.
+#[inline(always)]
+fn stencil_axis<W: Lanes>(x: W, len: usize, wide: W) -> ([W; 4], [W; 4]) {
+    let (zero, one) = (W::splat(0.0), W::splat(1.0));
+    let xc = clamp(x, zero, W::splat(len as f32));
+    let (i0, _) = axis(xc, len);
+    // The scalar kernel's constants, chosen per lane.
+    let outer = wide.select(W::splat(3.0), one);
+    let inner = wide.select(one, zero);
+    let last = W::splat((len - 1) as f32);
+    let idx = [
+        clamp(i0 - outer, zero, last),
+        clamp(i0 - inner, zero, last),
+        clamp(i0 + one + inner, zero, last),
+        clamp(i0 + one + outer, zero, last),
+    ];
+    let half = W::splat(0.5);
+    (idx, idx.map(|k| k + half - xc))
+}
+
+/// The 16 stencil samples `d[b][a]` (column `a`, row `b`): lane `k` reads `table(k)`
+/// (row-major, `w` wide) at column `ix[a]` and row `jy[b]`, converted as the scalar
+/// `VdtView::stencil` does (`as usize`: saturating, NaN → 0; the indices are clamped to
+/// the table, so every read is in range). One pass over the lanes.
+#[inline(always)]
+fn gather_stencil<'t, W: Lanes>(
+    table: impl Fn(usize) -> &'t [f32],
+    w: usize,
+    ix: &[W; 4],
+    jy: &[W; 4],
+) -> [[W; 4]; 4] {
+    // g[4·b + a][lane]: each vector is then one contiguous load (so the lane loop writes
+    // lane `k` of 16 arrays, which an iterator over `g` cannot express).
+    let mut g = [[0.0f32; 16]; 16];
+    #[allow(clippy::needless_range_loop)]
+    for k in 0..W::N {
+        let d = table(k);
+        let cols: [usize; 4] = core::array::from_fn(|a| ix[a].lanes()[k] as usize);
+        for (b, y) in jy.iter().enumerate() {
+            let row = y.lanes()[k] as usize * w;
+            for (a, &c) in cols.iter().enumerate() {
+                g[4 * b + a][k] = d.get(row + c).copied().unwrap_or(0.0);
+            }
+        }
+    }
+    core::array::from_fn(|b| core::array::from_fn(|a| W::load(&g[4 * b + a][..W::N])))
+}
+
+/// Sample positions of one stencil axis: mean, deviations from it, sum of squares (scalar
+/// `vdt::FitAxis`).
+struct FitAxis<W> {
+    mean: W,
+    dev: [W; 4],
+    ss: W,
+}
+
+#[inline(always)]
+fn fit_axis<W: Lanes>(p: [W; 4]) -> FitAxis<W> {
+    let mean = sum4(p) * W::splat(0.25);
+    let dev = p.map(|x| x - mean);
+    FitAxis {
+        mean,
+        dev,
+        ss: sum4(dev.map(|e| e * e)),
+    }
+}
+
+/// The least-squares plane through `d` (scalar `vdt::plane`): `[value, gx, gy]`.
+#[inline(always)]
+fn plane<W: Lanes>(d: &[[W; 4]; 4], ax: &FitAxis<W>, ay: &FitAxis<W>) -> [W; 3] {
+    let (zero, quarter) = (W::splat(0.0), W::splat(0.25));
+    let col: [W; 4] =
+        core::array::from_fn(|a| sum4([d[0][a], d[1][a], d[2][a], d[3][a]]) * quarter);
+    let row: [W; 4] = core::array::from_fn(|b| sum4(d[b]) * quarter);
+    let mean = sum4(col) * quarter;
+    let sx = sum4(core::array::from_fn(|a| ax.dev[a] * (col[a] - mean)));
+    let sy = sum4(core::array::from_fn(|b| ay.dev[b] * (row[b] - mean)));
+    let gx = ax.ss.gt(zero).select(sx / ax.ss, zero);
+    let gy = ay.ss.gt(zero).select(sy / ay.ss, zero);
+    [mean - gx * ax.mean - gy * ay.mean, gx, gy]
+}
+
+/// The samples with their zero level corrected for the staircase (scalar
+/// `vdt::zero_level_corrected`).
+#[inline(always)]
+fn zero_level_corrected<W: Lanes>(d: [[W; 4]; 4], gx: W, gy: W) -> [[W; 4]; 4] {
+    let (zero, one, half) = (W::splat(0.0), W::splat(1.0), W::splat(0.5));
+    let (ax, ay) = (gx.abs(), gy.abs());
+    let hi = max_num(ax, ay);
+    let q = hi.gt(zero).select(min_num(ax, ay) / hi, zero);
+    let m = one / (one + q * q).sqrt();
+    let p = q * m;
+    let c_half = half * m - half;
+    let c_diag = m + half * p - W::splat(FRAC_1_SQRT_2);
+    let c_far = W::splat(FIT_KAPPA) * p * (one - p);
+    let (near, mid) = (W::splat(0.6), W::splat(1.1));
+    d.map(|row| {
+        row.map(|x| {
+            let a = x.abs();
+            let c = a.lt(near).select(c_half, a.lt(mid).select(c_diag, c_far));
+            x.lt(zero).select(x - c, x + c)
+        })
+    })
+}
+
+/// The straight-edge fraction of the squares `(u, v, r)` (texel units), lane-wise scalar
+/// `VdtView::gradient` on a table of `w × h` samples: lane `k` reads `table(k)` (the VDT
+/// query passes one table for all lanes, the shading kernel each lane's own), and is
+/// bit-identical to `VdtView::gradient` of that table and lane.
+#[inline(always)]
+pub(crate) fn gradient_lanes<'t, W: Lanes>(
+    table: impl Fn(usize) -> &'t [f32],
+    w: usize,
+    h: usize,
+    [u, v, r]: [W; 3],
+) -> W {
+    // `r >= FIT_WIDE_R`: false for NaN (narrow), as in the scalar kernel.
+    let wide = r.ge(W::splat(FIT_WIDE_R));
+    let (ix, x) = stencil_axis(u, w, wide);
+    let (jy, y) = stencil_axis(v, h, wide);
+    let d = gather_stencil(table, w, &ix, &jy);
+    // `fit_stencil`: the raw plane's gradient drives the correction of the second plane.
+    let (ax, ay) = (fit_axis(x), fit_axis(y));
+    let [_, rgx, rgy] = plane(&d, &ax, &ay);
+    let [dd, gx, gy] = plane(&zero_level_corrected(d, rgx, rgy), &ax, &ay);
+    // `gradient_from`: D in units of the half-side r/√2.
+    halfplane_lanes(dd * W::splat(SQRT_2) / clamp_r(r), gx, gy)
+}
+
 /// The scalar `VdtView::query`, operation for operation: `[eq9, gradient]`.
 #[inline(always)]
 fn query_lanes<W: Lanes>(view: &VdtView<'_>, [u, v, r]: [W; 3]) -> [W; 2] {
     let (w, h) = (view.width(), view.height());
     let d = view.samples();
+    // Eq. 9 of the bilinear D.
     let (i0, fx) = axis(u, w);
     let (j0, fy) = axis(v, h);
     // Gather: `as usize` saturates and maps NaN to 0, as in the scalar kernel.
@@ -68,30 +257,9 @@ fn query_lanes<W: Lanes>(view: &VdtView<'_>, [u, v, r]: [W; 3]) -> [W; 2] {
     let d11 = W::from_fn(|k| at(k, dj + di));
     let d0 = lerp(d00, d10, fx);
     let d1 = lerp(d01, d11, fx);
-    let dd = lerp(d0, d1, fy);
-    let gx = lerp(d10 - d00, d11 - d01, fy);
-    let gy = lerp(d01 - d00, d11 - d10, fx);
-    let zero = W::splat(0.0);
-    let one = W::splat(1.0);
-    let rr = clamp(r, W::splat(R_MIN), W::splat(R_MAX));
-    let e9 = eq9_lanes(dd, rr);
-    // Straight-edge fraction.
-    let (ax, ay) = (gx.abs(), gy.abs());
-    let m = max_num(ax, ay);
-    let q = m.gt(zero).select(min_num(ax, ay) / m, zero);
-    let t = dd * W::splat(SQRT_2) / rr;
-    let len = (one + q * q).sqrt();
-    let hi = one + q;
-    let tt = clamp(t * len, -hi, hi);
-    let den = W::splat(8.0) * max_num(q, W::splat(Q_MIN));
-    let lo_e = tt + hi;
-    let lo_v = lo_e * lo_e / den;
-    let hi_e = hi - tt;
-    let hi_v = one - hi_e * hi_e / den;
-    let mid = (tt + one) * W::splat(0.5);
-    let is_lo = tt.le(q - one);
-    let is_hi = tt.ge(one - q);
-    let g = is_lo.select(lo_v, is_hi.select(hi_v, mid));
+    let e9 = eq9_lanes(lerp(d0, d1, fy), clamp_r(r));
+    // The straight-edge fraction of the fitted line.
+    let g = gradient_lanes(|_| d, w, h, [u, v, r]);
     [e9, g]
 }
 
@@ -173,6 +341,9 @@ mod tests {
             0.5,
             1e30,
             22.5,
+            FIT_WIDE_R,
+            FIT_WIDE_R.next_down(),
+            FIT_WIDE_R.next_up(),
         ];
         let n = 4000;
         let mut cols: [Vec<f32>; 3] = Default::default();
