@@ -6,6 +6,7 @@ pub mod brdf;
 pub mod cp;
 pub mod cp_transport;
 pub mod lobe_sum;
+pub mod memory;
 pub mod plot;
 pub mod product;
 pub mod rsl;

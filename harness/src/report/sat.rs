@@ -14,6 +14,7 @@ use serde_json::json;
 use steradian_core::rsl::sat::Sat;
 
 use super::Options;
+use super::memory;
 use super::plot::{Axis, Chart, Pt, Scale, Series};
 use super::section::Section;
 use super::timing::{median_time, ns_per};
@@ -127,6 +128,11 @@ pub struct SatTimes {
     pub warm_f32_int: Duration,
     /// Warm integer queries, ours.
     pub warm_int: Duration,
+    /// The warm fractional queries' loads alone (the same entries in the same order,
+    /// summed; no arithmetic): the memory floor of the kernel's layout.
+    pub warm_loads: Duration,
+    /// The cold fractional queries' loads alone.
+    pub cold_loads: Duration,
 }
 
 /// The wgpu measurements.
@@ -165,6 +171,51 @@ pub struct SatResults {
     pub gpu: SatGpu,
     /// Worst error over its stated bound on the high-dynamic-range grid.
     pub hdr_worst_of_bound: f64,
+    /// Table entries (`i64`) the warm queries read, per query (the load-only floor reads
+    /// 16, repeating a row where the kernel reuses it).
+    pub loads_per_query: f64,
+    /// Distinct cache lines the warm queries read, per query.
+    pub lines_per_query: f64,
+    /// The memory hierarchy, measured in the same run.
+    pub memory: Vec<memory::Level>,
+}
+
+/// Where `SatView::box_sum` reads for each box, as 24 bytes per box: per axis `sat::axis`,
+/// then the starts of rows `J0`, `J1` and, where the fraction is not 0, `J0 + 1` and
+/// `J1 + 1` (else `J0`, `J1` again), and the columns `I0`, `I1` (clamped to `w − 1`); it
+/// reads entries `I0`, `I0 + 1`, `I1`, `I1 + 1` of each of the four rows.
+fn load_plan(view: &steradian_core::rsl::sat::SatView<'_>, boxes: &[[f32; 4]]) -> Vec<[u32; 6]> {
+    let (w, h) = (view.width(), view.height());
+    boxes
+        .iter()
+        .map(|q| {
+            let (i0, _, i1, _) = steradian_core::rsl::sat::axis(q[0], q[2], w);
+            let (j0, b0, j1, b1) = steradian_core::rsl::sat::axis(q[1], q[3], h);
+            let (i0, i1) = (i0.min(w - 1), i1.min(w - 1));
+            let j0p = if b0 != 0.0 { j0 + 1 } else { j0 };
+            let j1p = if b1 != 0.0 { j1 + 1 } else { j1 };
+            let s = |l: usize| (l * (w + 1)) as u32;
+            [s(j0), s(j1), s(j0p), s(j1p), i0 as u32, i1 as u32]
+        })
+        .collect()
+}
+
+/// The sum of the sixteen entries of each box of `plan` (four accumulators, one per row):
+/// the loads of the kernel alone, with as little index traffic as the kernel's own input.
+fn sum_loads(sums: &[i64], plan: &[[u32; 6]]) -> i64 {
+    let mut acc = [0i64; 4];
+    for p in plan {
+        let (c0, c1) = (p[4] as usize, p[5] as usize);
+        for (a, &r) in acc.iter_mut().zip(&p[..4]) {
+            let r = r as usize;
+            *a = a
+                .wrapping_add(sums[r + c0])
+                .wrapping_add(sums[r + c0 + 1])
+                .wrapping_add(sums[r + c1])
+                .wrapping_add(sums[r + c1 + 1]);
+        }
+    }
+    acc.iter().fold(0, |x, &y| x.wrapping_add(y))
 }
 
 /// Error growth with resolution, per storage option.
@@ -427,6 +478,44 @@ pub fn measure(opts: &Options) -> Result<SatResults, Box<dyn Error>> {
             black_box(&wout);
         }
     });
+    // The loads alone, the same entries in the same order: the floor of this layout.
+    let sums = view.sums();
+    let warm_plan = load_plan(&view, warm);
+    let warm_loads = median_time(reps, || {
+        for _ in 0..rounds {
+            black_box(sum_loads(sums, black_box(&warm_plan)));
+        }
+    });
+    let cold_plan = load_plan(&view, qs);
+    let cold_loads = median_time(reps, || {
+        black_box(sum_loads(sums, black_box(&cold_plan)));
+    });
+    // Entries read per box (rows reused where a fraction is 0 are not read again) and
+    // distinct cache lines (two per row unless the two column pairs share one).
+    let rows_read = |p: &[u32; 6]| 2 + usize::from(p[2] != p[0]) + usize::from(p[3] != p[1]);
+    let loads_per_query =
+        warm_plan.iter().map(|p| 4 * rows_read(p)).sum::<usize>() as f64 / warm_n as f64;
+    let lines_per_query = warm_plan
+        .iter()
+        .map(|p| {
+            let per_row = |r: u32| {
+                let line = |c: u32| (r as usize + c as usize) * 8 / memory::LINE;
+                let mut l = [line(p[4]), line(p[4] + 1), line(p[5]), line(p[5] + 1)];
+                l.sort_unstable();
+                1 + l.windows(2).filter(|x| x[0] != x[1]).count()
+            };
+            let mut rows = vec![p[0], p[1]];
+            if p[2] != p[0] {
+                rows.push(p[2]);
+            }
+            if p[3] != p[1] {
+                rows.push(p[3]);
+            }
+            rows.into_iter().map(per_row).sum::<usize>()
+        })
+        .sum::<usize>() as f64
+        / warm_n as f64;
+    let memory = memory::measure(reps, opts.scaled(QUERIES) as f64 / QUERIES as f64);
     bar.inc(1);
 
     // 3. GPU.
@@ -461,10 +550,15 @@ pub fn measure(opts: &Options) -> Result<SatResults, Box<dyn Error>> {
             warm_simd,
             warm_f32_int,
             warm_int,
+            warm_loads,
+            cold_loads,
         },
         simd_bit_exact,
         gpu,
         hdr_worst_of_bound,
+        loads_per_query,
+        lines_per_query,
+        memory,
     })
 }
 
@@ -558,6 +652,19 @@ fn summary(r: &SatResults) -> String {
         r.warm_ns(t.warm_int),
         r.warm_ns(t.warm_f32_int)
     );
+    let _ = writeln!(
+        summary,
+        "  roofline: {:.1} i64 loads ({:.1} cache lines) per query; the loads alone take {:.2} ns/query warm, {:.2} cold; SIMD at {:.2}× (warm) and {:.2}× (cold) of that floor, scalar at {:.2}× and {:.2}×",
+        r.loads_per_query,
+        r.lines_per_query,
+        r.warm_ns(t.warm_loads),
+        r.ns(t.cold_loads),
+        ratio(t.warm_simd, t.warm_loads),
+        ratio(t.simd, t.cold_loads),
+        ratio(t.warm_scalar, t.warm_loads),
+        ratio(t.scalar, t.cold_loads)
+    );
+    let _ = writeln!(summary, "  {}", memory::summary(&r.memory));
     if let (Some(e), Some(rel)) = (r.gpu.max_ulps, r.gpu.max_rel_vs_cpu) {
         let _ = writeln!(
             summary,
@@ -699,6 +806,11 @@ fn data(r: &SatResults) -> serde_json::Value {
             "integer_ours": r.ns(t.int_ours), "integer_plain_f32": r.ns(t.int_f32),
             "warm_scalar": warm(t.warm_scalar), "warm_simd": warm(t.warm_simd),
             "warm_integer_ours": warm(t.warm_int), "warm_integer_plain_f32": warm(t.warm_f32_int),
+            "warm_loads_only": warm(t.warm_loads), "cold_loads_only": r.ns(t.cold_loads),
+        },
+        "roofline": {
+            "loads_per_query": r.loads_per_query, "lines_per_query": r.lines_per_query,
+            "memory": r.memory,
         },
         "simd_bit_exact": r.simd_bit_exact,
         "gpu": {"adapter": r.gpu.note, "max_ulps_vs_f64": r.gpu.max_ulps, "max_rel_to_A_vs_cpu": r.gpu.max_rel_vs_cpu},
