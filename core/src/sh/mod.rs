@@ -177,7 +177,7 @@ const fn residual(x: f64, r: f64) -> f64 {
 /// Entries of a lower-triangular `(l, m)` table, `0 ≤ m ≤ l < MAX_BANDS`.
 const TRI: usize = MAX_BANDS * (MAX_BANDS + 1) / 2;
 
-/// The position of `(l, m)`, `m ≤ l`, in the triangular tables [`A`] and [`B`].
+/// The position of `(l, m)`, `m ≤ l`, in the triangular tables [`A`] and [`AB`].
 #[inline(always)]
 pub const fn tri(l: usize, m: usize) -> usize {
     l * (l + 1) / 2 + m
