@@ -79,21 +79,57 @@ pub fn box_sum(sat: &SatView<'_>, u0: f32x8, v0: f32x8, u1: f32x8, v1: f32x8) ->
         let r = (i64x8::new(s).round_float() * q).to_array();
         f32x8::new(r.map(|v| v as f32))
     } else {
-        // Per lane, the nine exact sub-box sums (the scalar kernel's own reads and integer
-        // differences), then the f64 combination in the scalar order, lane-wise (no fused
-        // multiply-add). Rows J + 1 are read only where their weight is non-zero, as in
-        // the scalar kernel.
+        // The scalar kernel's sixteen entries per lane (`SatView::integer_terms`: rows `J0`,
+        // `J1`, and `J + 1` where the fraction is non-zero, else `J` again; columns `I0`,
+        // `I0 + 1`, `I1`, `I1 + 1`; a row past the table reads as zeros), stored lane-major
+        // and loaded as sixteen `i64x8`, then its 27 wrapping subtractions lane-wise
+        // (wrapping `i64` arithmetic is exact modulo 2⁶⁴: the scalar terms, bit for bit).
+        let (sums, w1, wl) = (sat.sums(), sat.width() + 1, sat.width() - 1);
         let (bl0, bl1) = (b0.to_array(), b1.to_array());
-        let mut t = [[0i64; 8]; 9];
+        let mut e = [[0i64; 8]; 16];
         for k in 0..8 {
-            let kk = sat.integer_terms((i0[k], i1[k]), (j0[k], j1[k]), (bl0[k], bl1[k]));
-            for r in 0..3 {
-                for c in 0..3 {
-                    t[3 * r + c][k] = kk[r][c];
+            let (c0, c1) = (i0[k].min(wl), i1[k].min(wl));
+            let rows = [
+                j0[k],
+                j1[k],
+                if bl0[k] != 0.0 {
+                    j0[k].saturating_add(1)
+                } else {
+                    j0[k]
+                },
+                if bl1[k] != 0.0 {
+                    j1[k].saturating_add(1)
+                } else {
+                    j1[k]
+                },
+            ];
+            for (r, &l) in rows.iter().enumerate() {
+                let row = l
+                    .checked_mul(w1)
+                    .and_then(|s| sums.get(s..s.checked_add(w1)?));
+                let v = match row {
+                    Some(row) => [row[c0], row[c0 + 1], row[c1], row[c1 + 1]],
+                    None => [0; 4],
+                };
+                for (c, x) in v.into_iter().enumerate() {
+                    e[4 * r + c][k] = x;
                 }
             }
         }
-        let f = |n: usize| i64x8::new(t[n]).round_float();
+        let row = |r: usize| -> [i64x8; 4] { core::array::from_fn(|c| i64x8::new(e[4 * r + c])) };
+        let (r0, r1, r0p, r1p) = (row(0), row(1), row(2), row(3));
+        let d = |l: [i64x8; 4], m: [i64x8; 4]| -> [i64x8; 3] {
+            [
+                (m[2] - m[0]) - (l[2] - l[0]),
+                (m[3] - m[2]) - (l[3] - l[2]),
+                (m[1] - m[0]) - (l[1] - l[0]),
+            ]
+        };
+        let [t0, t1, t2] = [d(r0, r1), d(r1, r1p), d(r0, r0p)];
+        let t = [
+            t0[0], t0[1], t0[2], t1[0], t1[1], t1[2], t2[0], t2[1], t2[2],
+        ];
+        let f = |n: usize| t[n].round_float();
         let (a0, a1, b0, b1) = (widen(a0), widen(a1), widen(b0), widen(b1));
         let x = |n: usize| (f(n) + a1 * f(n + 1)) - a0 * f(n + 2);
         let (x_box, x_top, x_bottom) = (x(0), x(3), x(6));
