@@ -224,10 +224,7 @@ pub fn exponent_coord(e: f32) -> f32 {
 }
 
 /// `(1 ± cos φ)` of the angle `φ = atan2(sn, cs)` (`sn ≥ 0`), each without cancellation:
-/// `(1 − cos φ, 1 + cos φ)`. With `h = |(sn, cs)|` and `h⁺ = h + |cs|`,
-/// `1 + |cos φ| = h⁺/h = h⁺²/(h·h⁺)` and `1 − |cos φ| = sn²/(h·h⁺)` (`(1 − |cos|)(1 + |cos|)
-/// = sin²`): one division for both; the sign of `cs` says which is which. The callers'
-/// pairs have `h ≈ 1` (a sine and cosine up to rounding), so `h·h⁺ ∈ [1, 2]` roughly.
+/// `(1 − cos φ, 1 + cos φ)`.
 #[inline]
 fn one_pm_cos(sn: f32, cs: f32) -> (f32, f32) {
     let h = math::sqrtf(sn * sn + cs * cs);
@@ -659,4 +656,92 @@ pub fn product_with(
     // 2π·peak/(e_r + 1) = I.
     let e_r = exp_fast(LN_TWO_PI + ln_peak - ln_i) - 1.0;
     CosineLobe::saturating(axis, scaled(ln_peak), e_r.max(0.0))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// `atan2_pos` against the `f64` `atan2` over every magnitude and both signs of `x`
+    /// (within `4e-7` relative where the result is a normal `f32`: Cephes' `1.9e-7` plus the
+    /// reduction's roundings; within one `f32::MIN_POSITIVE` below that), exact at
+    /// the axes and signed zeros, NaN for NaN.
+    #[test]
+    fn atan2_pos_against_f64() {
+        let mut worst = 0.0f64;
+        let mut y = 1e-30f32;
+        while y < 1e30 {
+            let mut x = 1e-30f32;
+            while x < 1e30 {
+                for xs in [x, -x] {
+                    let got = atan2_pos(y, xs) as f64;
+                    let want = (y as f64).atan2(xs as f64);
+                    // Results below f32's normal range are subnormal or 0 in f32.
+                    let err = if want >= f32::MIN_POSITIVE as f64 {
+                        (got - want).abs() / want
+                    } else {
+                        (got - want).abs() / f32::MIN_POSITIVE as f64
+                    };
+                    worst = worst.max(err);
+                }
+                x *= 1.37;
+            }
+            y *= 1.41;
+        }
+        assert!(worst < 4e-7, "{worst}");
+        assert_eq!(atan2_pos(0.0, 1.0), 0.0);
+        assert_eq!(atan2_pos(0.0, -1.0), crate::PI);
+        assert_eq!(atan2_pos(0.0, -0.0), crate::PI);
+        assert_eq!(atan2_pos(1.0, 0.0), core::f32::consts::FRAC_PI_2);
+        assert_eq!(atan2_pos(1.0, -0.0), core::f32::consts::FRAC_PI_2);
+        assert!(atan2_pos(f32::NAN, 1.0).is_nan() && atan2_pos(1.0, f32::NAN).is_nan());
+    }
+
+    /// `exp_fast` is `math::expf` bit for bit, through both cut-offs and beyond.
+    #[test]
+    fn exp_fast_is_expf() {
+        let mut y = -120.0f32;
+        while y < 100.0 {
+            assert_eq!(exp_fast(y).to_bits(), math::expf(y).to_bits(), "{y}");
+            y += 1.0 / 1024.0;
+        }
+        for y in [
+            -104.0f32,
+            -103.97,
+            88.72,
+            88.73,
+            89.0,
+            f32::INFINITY,
+            f32::NEG_INFINITY,
+        ] {
+            assert_eq!(exp_fast(y).to_bits(), math::expf(y).to_bits(), "{y}");
+        }
+        assert!(exp_fast(f32::NAN).is_nan());
+    }
+
+    /// `ln_cos_half` keeps its relative precision from `t = 1e-6` (where `e·ln cos t` at
+    /// `e = 1e5` needs it) to just below `π/2`: within `1e-6` of the `f64` `ln cos t` fed the
+    /// same `f32` pair `(1 − cos 2t, 1 + cos 2t)`.
+    #[test]
+    fn ln_cos_half_keeps_relative_precision() {
+        let mut t = 1e-6f64;
+        while t < 1.57 {
+            // 1 ∓ cos 2t = 2·sin²t, 2·cos²t.
+            let (omc, opc) = (
+                (2.0 * t.sin().powi(2)) as f32,
+                (2.0 * t.cos().powi(2)) as f32,
+            );
+            let want = if omc < opc {
+                0.5 * (-(omc as f64) / 2.0).ln_1p()
+            } else {
+                0.5 * (opc as f64 / 2.0).ln()
+            };
+            let got = ln_cos_half(omc, opc) as f64;
+            assert!(
+                (got - want).abs() <= 1e-6 * want.abs(),
+                "t {t}: {got} vs {want}"
+            );
+            t *= 1.01;
+        }
+    }
 }
