@@ -384,6 +384,18 @@ pub(crate) mod tests {
         a.to_bits() == b.to_bits() || (a.is_nan() && b.is_nan())
     }
 
+    /// A seeded stream of uniform `f32` in `[0, 1)` (Knuth's MMIX LCG, the top 24 bits) for
+    /// the unit tests' random inputs.
+    pub(crate) fn uniform(seed: u64) -> impl FnMut() -> f32 {
+        let mut s = seed;
+        move || {
+            s = s
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (s >> 40) as f32 / (1u64 << 24) as f32
+        }
+    }
+
     /// Every spelling of `max`/`min`/`clamp` against `f32::max`/`min`/`clamp`, on both
     /// vector widths (pairs of zeros of opposite signs excepted: `f32::max` may return
     /// either).

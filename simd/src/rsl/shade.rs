@@ -742,13 +742,7 @@ mod tests {
     /// (NaN, ±∞, zeros, huge, the half-diagonals around `FIT_WIDE_R`) in every lane.
     #[test]
     fn vdt_fraction_matches_vdt_visibility_bit_for_bit() {
-        let mut s = 0x5eed_u64;
-        let mut next = || {
-            s = s
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            (s >> 40) as f32 / (1u64 << 24) as f32
-        };
+        let mut next = crate::lanes::tests::uniform(0x5eed_u64);
         let specials = [
             f32::NAN,
             f32::INFINITY,

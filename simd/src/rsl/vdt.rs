@@ -320,13 +320,7 @@ mod tests {
     #[test]
     fn lanes_match_scalar_bit_for_bit() {
         let (w, h) = (23, 17);
-        let mut s = 12345u64;
-        let mut next = || {
-            s = s
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            (s >> 40) as f32 / (1u64 << 24) as f32
-        };
+        let mut next = crate::lanes::tests::uniform(12345u64);
         let mask: Vec<bool> = (0..w * h).map(|_| next() < 0.55).collect();
         let d = table(w, h, &mask);
         let view = VdtView::new(w, h, &d).unwrap();
