@@ -15,7 +15,7 @@ use steradian_core::rsl::shade::{self, ShadeLight, VdtQuery, VdtVisibility};
 
 use super::Options;
 use super::section::Section;
-use super::timing::{median_time_for, per_second};
+use super::timing::{median_time_for, median_times_in_turns, per_second, timed};
 use crate::backend::gpu::{Custom, try_gpu};
 use crate::env::decompose::{Decomposition, Objective, Options as DecOptions, PAPER_KS, decompose};
 use crate::env::{self, CubeMap};
@@ -162,43 +162,52 @@ fn throughput(opts: &Options) -> Result<Throughput, Box<dyn Error>> {
     let vdts = sh::par_map(&scene.points, |p| sh::point_vdt(&scene, p, 64));
     let evals = scene.points.len() * lights.len();
     let cpu_min = Duration::from_millis(opts.scaled(CPU_MIN_MS) as u64);
-    let time = |f: &mut dyn FnMut()| median_time_for(opts.repeats, cpu_min, f);
-    let t_scalar = time(&mut || {
-        for (p, v) in scene.points.iter().zip(&vdts) {
-            if let Ok(vis) = VdtVisibility::new(v.view(), VdtQuery::Gradient) {
-                black_box(shade::shade(&p.frame, p.wo, &sat, &vis, black_box(&lights)));
+    let moments: Vec<_> = sh::par_map(&scene.points, |p| sh::point_moments(&scene, p, 64));
+    // The four CPU kernels take turns (scalar eq. 5, moments scalar, moments SIMD, eq. 5
+    // SIMD), so that a noisy machine slows them alike and their ratios stay meaningful;
+    // rounds until the scalar kernel's runs fill `cpu_min` (at least `--repeats`, at most 50).
+    let run = |i: usize| match i {
+        0 => {
+            for (p, v) in scene.points.iter().zip(&vdts) {
+                if let Ok(vis) = VdtVisibility::new(v.view(), VdtQuery::Gradient) {
+                    black_box(shade::shade(&p.frame, p.wo, &sat, &vis, black_box(&lights)));
+                }
             }
         }
-    });
-    let moments: Vec<_> = sh::par_map(&scene.points, |p| sh::point_moments(&scene, p, 64));
-    let t_moments = time(&mut || {
-        for (p, m) in scene.points.iter().zip(&moments) {
-            black_box(shade::shade_moments(
-                &p.frame,
-                p.wo,
+        1 => {
+            for (p, m) in scene.points.iter().zip(&moments) {
+                black_box(shade::shade_moments(
+                    &p.frame,
+                    p.wo,
+                    &sat,
+                    m,
+                    black_box(&lights),
+                ));
+            }
+        }
+        2 => {
+            black_box(sh::shade_points_moments_simd(
+                &scene,
                 &sat,
-                m,
+                &moments,
                 black_box(&lights),
             ));
         }
-    });
-    let t_moments_simd = time(&mut || {
-        black_box(sh::shade_points_moments_simd(
-            &scene,
-            &sat,
-            &moments,
-            black_box(&lights),
-        ));
-    });
-    let t_simd = time(&mut || {
-        black_box(sh::shade_points_simd(
-            &scene,
-            &sat,
-            &vdts,
-            black_box(&lights),
-            VdtQuery::Gradient,
-        ));
-    });
+        _ => {
+            black_box(sh::shade_points_simd(
+                &scene,
+                &sat,
+                &vdts,
+                black_box(&lights),
+                VdtQuery::Gradient,
+            ));
+        }
+    };
+    let (_, once) = timed(|| run(0));
+    let rounds = (cpu_min.as_secs_f64() / once.as_secs_f64().max(1e-9)).ceil() as usize;
+    let rounds = rounds.clamp(opts.repeats.max(3), opts.repeats.max(50));
+    let t = median_times_in_turns(rounds, 4, run);
+    let (t_scalar, t_moments, t_moments_simd, t_simd) = (t[0], t[1], t[2], t[3]);
     let gpu_copies = opts.scaled(GPU_COPIES);
     let gpu = if !opts.gpu {
         Err("not requested".to_string())
