@@ -100,30 +100,40 @@ pub fn sphrs_set(bands: usize) -> sphrs::HarmonicsSet<f64, sphrs::RealSH> {
 }
 
 /// Multiply–add pairs per nanosecond (counted per lane) of this binary on this machine on
-/// four `f64` lanes
-/// (`wide::f64x4`, the SIMD twin's type): eight independent `a = a·b + c` chains (median of
-/// five runs after a warm-up), a multiply and an add, not a fused multiply-add (the SH
-/// recurrence compiles to those). The one-lane rate is a quarter of it: the same execution
-/// units run both, and a scalar loop cannot be timed on its own, because the compiler
-/// packs independent scalar chains into vectors.
+/// the SIMD evaluation's `f64` lanes (`wide::f64x8` where the build enables AVX-512F,
+/// `f64x4` otherwise: `steradian_simd::sh::SLICE_LANES`): eight independent `a = a·b + c`
+/// chains (median of five runs after a warm-up), a multiply and an add, not a fused
+/// multiply-add (the SH recurrence compiles to those). The one-lane rate is that divided by
+/// the lane count: the same execution units run both, and a scalar loop cannot be timed on
+/// its own, because the compiler packs independent scalar chains into vectors.
 pub fn mul_add_rate() -> f64 {
-    use wide::f64x4;
-    let iters = 20_000_000u64;
-    let lanes = || {
-        let mut a: [f64x4; 8] = std::array::from_fn(|k| f64x4::splat(1.0 + 0.1 * k as f64));
-        let (b, c) = (
-            f64x4::splat(black_box(0.999_999_9f64)),
-            f64x4::splat(black_box(1e-9f64)),
-        );
-        for _ in 0..iters / 32 {
-            for v in a.iter_mut() {
-                *v = *v * b + c;
-            }
-        }
-        black_box(a);
-    };
-    let t = crate::report::timing::median_time(5, lanes);
-    iters as f64 / (t.as_secs_f64() * 1e9)
+    // The lanes of the SIMD evaluation (`steradian_simd::sh::SLICE_LANES`).
+    macro_rules! rate {
+        ($t:ident, $n:literal) => {{
+            use wide::$t;
+            let iters = 20_000_000u64;
+            let lanes = || {
+                let mut a: [$t; 8] = std::array::from_fn(|k| $t::splat(1.0 + 0.1 * k as f64));
+                let (b, c) = (
+                    $t::splat(black_box(0.999_999_9f64)),
+                    $t::splat(black_box(1e-9f64)),
+                );
+                for _ in 0..iters / (8 * $n) {
+                    for v in a.iter_mut() {
+                        *v = *v * b + c;
+                    }
+                }
+                black_box(a);
+            };
+            let t = crate::report::timing::median_time(5, lanes);
+            iters as f64 / (t.as_secs_f64() * 1e9)
+        }};
+    }
+    if steradian_simd::sh::SLICE_LANES == 8 {
+        rate!(f64x8, 8)
+    } else {
+        rate!(f64x4, 4)
+    }
 }
 
 /// The input rows of `wgsl::SH_HVL`, one per HVL: centre, its frame's tangent, bitangent

@@ -12,7 +12,7 @@
 //! | [`lobe::product`] | [`lobe::product::product_x8`] | `product_slices` | axis bit-identical; scale, exponent within [`lobe::product::SCALE_REL_TOL`] etc. |
 //! | [`rsl::sat`] | [`rsl::sat::box_sum`], [`rsl::sat::square`] | `box_sum_slices`, `square_slices` | bit-identical |
 //! | [`rsl::vdt`] | [`rsl::vdt::query`] | `query_slices` | bit-identical |
-//! | [`sh`] | [`sh::eval_x4`] (four directions, `f64` lanes as the scalar kernel) | `eval_slices` | bit-identical |
+//! | [`sh`] | [`sh::eval_x4`], [`sh::eval_x8`] (four or eight directions, `f64` lanes as the scalar kernel) | `eval_slices` (eight lanes with AVX-512F, four otherwise) | bit-identical |
 //! | [`sh::cap`] | [`sh::cap::coefficients_x4`] (four caps, `f64` lanes) | `coefficients_slices` | bit-identical |
 //! | [`sh::hvl`] | [`sh::hvl::contributions_x4`] (four HVLs, one receiver) | `contributions` | bit-identical |
 //! | [`sh::irradiance`] | [`sh::irradiance::irradiance_x4`] (one radiance vector, four normals) | `irradiance_slices` | bit-identical |

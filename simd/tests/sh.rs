@@ -5,7 +5,7 @@
 
 use glam::Vec3;
 use steradian_core::sh::{self, MAX_BANDS};
-use steradian_simd::sh::{eval_slices, eval_x4};
+use steradian_simd::sh::{eval_slices, eval_x4, eval_x8};
 
 use crate::common::lanes::{LENGTHS, in_every_lane, same};
 use crate::common::rng::Rng;
@@ -78,6 +78,30 @@ fn many_bands_and_the_x4_entry_point() {
             }
         }
     }
+}
+
+#[test]
+fn the_x8_entry_point_every_lane_with_special_values() {
+    let mut rng = Rng(8);
+    let mut dirs: [Vec3; 8] = core::array::from_fn(|_| rng.dir());
+    // Special directions in some lanes: the poles, the zero vector, NaN and a subnormal.
+    dirs[1] = Vec3::Z;
+    dirs[3] = Vec3::ZERO;
+    dirs[5] = Vec3::new(f32::NAN, 0.0, 1.0);
+    dirs[6] = Vec3::new(1e-45, 0.0, -1e-45);
+    dirs[7] = -Vec3::Z;
+    for bands in [1usize, 3, 8, 30, MAX_BANDS] {
+        let mut out = vec![[0.0f32; 8]; bands * bands];
+        eval_x8(dirs, bands, &mut out).expect("valid band count");
+        for (lane, d) in dirs.iter().enumerate() {
+            let want = scalar(*d, bands);
+            for (k, w) in want.iter().enumerate() {
+                assert!(same(out[k][lane], *w), "bands {bands} lane {lane} k {k}");
+            }
+        }
+    }
+    let mut short = vec![[0.0f32; 8]; 3];
+    assert!(eval_x8([Vec3::Z; 8], 2, &mut short).is_err());
 }
 
 #[test]

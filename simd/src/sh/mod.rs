@@ -1,13 +1,16 @@
-//! Real spherical harmonics, four directions at a time (mirrors `steradian_core::sh`).
+//! Real spherical harmonics, four or eight directions at a time (mirrors
+//! `steradian_core::sh`).
 //!
-//! [`eval_x4`] normalises the four directions on `wide::f64x4` lanes with the operations of
+//! [`eval_x4`] ([`eval_x8`]) normalises the directions on `wide::f64x4` (`f64x8`) lanes with
+//! the operations of
 //! `steradian_core::sh::unit_direction` (one correctly rounded square root, division and
 //! three products per lane) and runs the scalar kernel's `f64` recurrence on the lanes with
 //! the same operations in the same order, the same orders `m` grouped by
 //! `steradian_core::sh::CHAINS` (the per-order constants `Π_m^m` and `√2·Π_m^m` do not
 //! depend on the direction and are computed once per batch), so every lane is
 //! **bit-identical** to `steradian_core::sh::eval_into`, NaN included. [`eval_slices`] runs
-//! it over structure-of-arrays columns.
+//! it over structure-of-arrays columns, eight directions per pass where the build enables
+//! AVX-512F (one `f64x8` per 512-bit register), four otherwise.
 //!
 //! # References
 //!
@@ -18,56 +21,77 @@ pub mod hvl;
 pub mod irradiance;
 pub mod rotate;
 
+use core::ops::{Add, Mul, Sub};
 use steradian_core::sh::{A, AB, CHAINS, DIAG, MAX_GROUP, SUB, Y00_F64, check_shape, group, tri};
 use steradian_core::{Error, Vec3};
-use wide::f64x4;
+use wide::{f64x4, f64x8};
 
-/// All `bands²` real SH at four directions: `out[k][lane]` is coefficient `k`
-/// (index `l² + l + m`) of `dirs[lane]`, lane-wise `steradian_core::sh::eval_into`,
-/// bit-identical.
-///
-/// Errors: `bands > MAX_BANDS` or `out` shorter than `bands²`.
-pub fn eval_x4(dirs: [Vec3; 4], bands: usize, out: &mut [[f32; 4]]) -> Result<(), Error> {
-    check_shape(bands, out.len())?;
-    let lanes = |f: fn(&Vec3) -> f32| f64x4::new(dirs.each_ref().map(|d| f64::from(f(d))));
-    let u = unit_lanes(lanes(|d| d.x), lanes(|d| d.y), lanes(|d| d.z));
-    fill(u, bands, &mut |k, v| out[k] = narrow(v));
-    Ok(())
+/// `f64` lanes of any width: what [`fill`] needs.
+trait F64Lanes: Copy + Add<Output = Self> + Sub<Output = Self> + Mul<Output = Self> {
+    fn splat(v: f64) -> Self;
 }
 
-/// The four lanes rounded to `f32` (the scalar kernel's `as f32`).
-#[inline(always)]
-fn narrow(v: f64x4) -> [f32; 4] {
-    let a = v.to_array();
-    [a[0] as f32, a[1] as f32, a[2] as f32, a[3] as f32]
+macro_rules! lanes_kernels {
+    ($t:ident, $n:literal, $eval:ident, $narrow:ident, $unit:ident, $words:literal) => {
+        impl F64Lanes for $t {
+            #[inline(always)]
+            fn splat(v: f64) -> Self {
+                $t::splat(v)
+            }
+        }
+
+        #[doc = concat!("All `bands²` real SH at ", $words, " directions: `out[k][lane]` is coefficient `k`")]
+        /// (index `l² + l + m`) of `dirs[lane]`, lane-wise `steradian_core::sh::eval_into`,
+        /// bit-identical.
+        ///
+        /// Errors: `bands > MAX_BANDS` or `out` shorter than `bands²`.
+        pub fn $eval(dirs: [Vec3; $n], bands: usize, out: &mut [[f32; $n]]) -> Result<(), Error> {
+            check_shape(bands, out.len())?;
+            let lanes = |f: fn(&Vec3) -> f32| $t::new(dirs.each_ref().map(|d| f64::from(f(d))));
+            let u = $unit(lanes(|d| d.x), lanes(|d| d.y), lanes(|d| d.z));
+            fill(u, bands, &mut |k, v| out[k] = $narrow(v));
+            Ok(())
+        }
+
+        /// The lanes rounded to `f32` (the scalar kernel's `as f32`).
+        #[inline(always)]
+        fn $narrow(v: $t) -> [f32; $n] {
+            let a = v.to_array();
+            core::array::from_fn(|k| a[k] as f32)
+        }
+
+        /// `steradian_core::sh::unit_direction` on the lanes: the same operations (`r²`
+        /// summed left to right, `1/√r²`, three products), `+z` where `r² = 0`, NaN where `r²`
+        /// is not finite.
+        #[inline(always)]
+        fn $unit(x: $t, y: $t, z: $t) -> [$t; 3] {
+            let r2 = x * x + y * y + z * z;
+            let inv = $t::ONE / r2.sqrt();
+            let zero = r2.simd_eq($t::ZERO);
+            let finite = r2.simd_lt($t::splat(f64::INFINITY));
+            let nan = $t::splat(f64::NAN);
+            let fix = |v: $t, at_zero: f64| {
+                finite.select(zero.select($t::splat(at_zero), v * inv), nan)
+            };
+            [fix(x, 0.0), fix(y, 0.0), fix(z, 1.0)]
+        }
+    };
 }
 
-/// `steradian_core::sh::unit_direction` on four lanes: the same operations (`r²` summed
-/// left to right, `1/√r²`, three products), `+z` where `r² = 0`, NaN where `r²` is not
-/// finite.
-#[inline(always)]
-fn unit_lanes(x: f64x4, y: f64x4, z: f64x4) -> [f64x4; 3] {
-    let r2 = x * x + y * y + z * z;
-    let inv = f64x4::ONE / r2.sqrt();
-    let zero = r2.simd_eq(f64x4::ZERO);
-    let finite = r2.simd_lt(f64x4::splat(f64::INFINITY));
-    let nan = f64x4::splat(f64::NAN);
-    let fix =
-        |v: f64x4, at_zero: f64| finite.select(zero.select(f64x4::splat(at_zero), v * inv), nan);
-    [fix(x, 0.0), fix(y, 0.0), fix(z, 1.0)]
-}
+lanes_kernels!(f64x4, 4, eval_x4, narrow4, unit_lanes4, "four");
+lanes_kernels!(f64x8, 8, eval_x8, narrow8, unit_lanes8, "eight");
 
-/// The scalar kernel's recurrence (`steradian_core::sh`'s `fill`) on four lanes;
+/// The scalar kernel's recurrence (`steradian_core::sh`'s `fill`) on the lanes;
 /// `put(k, v)` receives coefficient `k` (the sine part of each `(l, m)` before its cosine
 /// part, coefficient 0 last, as the scalar kernel writes them).
 #[inline(always)]
-fn fill(u: [f64x4; 3], bands: usize, put: &mut impl FnMut(usize, f64x4)) {
+fn fill<F: F64Lanes>(u: [F; 3], bands: usize, put: &mut impl FnMut(usize, F)) {
     if bands == 0 {
         return;
     }
     let [x, y, z] = u;
-    let sp = f64x4::splat;
-    let step = |k: usize, q1: f64x4, q2: f64x4| sp(A[k]) * z * q1 - sp(AB[k]) * q2;
+    let sp = F::splat;
+    let step = |k: usize, q1: F, q2: F| sp(A[k]) * z * q1 - sp(AB[k]) * q2;
     let (mut pmm, mut c, mut s) = (Y00_F64, sp(1.0), sp(0.0));
     let mut m0 = 0;
     while m0 < bands {
@@ -123,9 +147,26 @@ fn fill(u: [f64x4; 3], bands: usize, put: &mut impl FnMut(usize, f64x4)) {
     put(0, sp(Y00_F64) + sp(0.0) * z);
 }
 
-/// [`eval_x4`] over structure-of-arrays columns: coefficient `k` of direction
-/// `(x[i], y[i], z[i])` goes to `out[k·len + i]` (`len = x.len()`). Any length (the tail is
-/// padded with `+z` and not written).
+/// Directions per pass of [`eval_slices`]: 8 where the build enables AVX-512F, 4 otherwise.
+pub const SLICE_LANES: usize = slice_lanes::N;
+
+/// Lanes of [`eval_slices`]: `f64x8` where the build enables AVX-512F, `f64x4` otherwise.
+#[cfg(target_feature = "avx512f")]
+mod slice_lanes {
+    pub(super) use super::{narrow8 as narrow, unit_lanes8 as unit_lanes};
+    pub(super) use wide::f64x8 as L;
+    pub(super) const N: usize = 8;
+}
+#[cfg(not(target_feature = "avx512f"))]
+mod slice_lanes {
+    pub(super) use super::{narrow4 as narrow, unit_lanes4 as unit_lanes};
+    pub(super) use wide::f64x4 as L;
+    pub(super) const N: usize = 4;
+}
+
+/// [`eval_x8`] (AVX-512F builds) or [`eval_x4`] over structure-of-arrays columns:
+/// coefficient `k` of direction `(x[i], y[i], z[i])` goes to `out[k·len + i]`
+/// (`len = x.len()`). Any length (the tail is padded with `+z` and not written).
 ///
 /// Errors: the direction columns of different lengths, `bands > MAX_BANDS`, or `out` not of
 /// length `bands²·len`.
@@ -146,21 +187,43 @@ pub fn eval_slices(
             max: (bands * bands * len) as f32,
         });
     }
-    // Whole groups of four: one 16-byte store per coefficient.
-    let whole = len - len % 4;
-    let col = |v: &[f32], i: usize| f64x4::new(core::array::from_fn(|k| f64::from(v[i + k])));
-    for i in (0..whole).step_by(4) {
+    // Straight-line code for the band counts renderers use most, as the scalar kernel
+    // (the count a constant: same operations, same bits).
+    match bands {
+        2 => columns(x, y, z, 2, out),
+        3 => columns(x, y, z, 3, out),
+        4 => columns(x, y, z, 4, out),
+        5 => columns(x, y, z, 5, out),
+        6 => columns(x, y, z, 6, out),
+        7 => columns(x, y, z, 7, out),
+        8 => columns(x, y, z, 8, out),
+        9 => columns(x, y, z, 9, out),
+        10 => columns(x, y, z, 10, out),
+        _ => columns(x, y, z, bands, out),
+    }
+    Ok(())
+}
+
+/// The loops of [`eval_slices`] (shapes checked by it).
+#[inline(always)]
+fn columns(x: &[f32], y: &[f32], z: &[f32], bands: usize, out: &mut [f32]) {
+    use slice_lanes::{L, N, narrow, unit_lanes};
+    let len = x.len();
+    // Whole groups of lanes: one store of `N` values per coefficient.
+    let whole = len - len % N;
+    let col = |v: &[f32], i: usize| L::new(core::array::from_fn(|k| f64::from(v[i + k])));
+    for i in (0..whole).step_by(N) {
         let u = unit_lanes(col(x, i), col(y, i), col(z, i));
         fill(u, bands, &mut |c, v| {
             let at = c * len + i;
-            out[at..at + 4].copy_from_slice(&narrow(v));
+            out[at..at + N].copy_from_slice(&narrow(v));
         });
     }
     // The tail, padded with `+z` and not written.
     if whole < len {
         let live = len - whole;
         let pad = |v: &[f32], fill: f32| {
-            f64x4::new(core::array::from_fn(|k| {
+            L::new(core::array::from_fn(|k| {
                 f64::from(if k < live { v[whole + k] } else { fill })
             }))
         };
@@ -170,5 +233,4 @@ pub fn eval_slices(
             out[at..at + live].copy_from_slice(&narrow(v)[..live]);
         });
     }
-    Ok(())
 }
