@@ -46,6 +46,12 @@ fn widen(x: f32x8) -> f64x8 {
     f64x8::new(x.to_array().map(f64::from))
 }
 
+/// `sums[idx[k]]` in lane `k`, 0 past the end (one lane-wise load).
+#[inline(always)]
+fn gather(sums: &[i64], idx: [usize; 8]) -> i64x8 {
+    i64x8::new(idx.map(|i| sums.get(i).copied().unwrap_or(0)))
+}
+
 /// Eight box sums: lane `k` is `sat.box_sum(u0[k], v0[k], u1[k], v1[k])`, bit-identical.
 #[inline]
 pub fn box_sum(sat: &SatView<'_>, u0: f32x8, v0: f32x8, u1: f32x8, v1: f32x8) -> f32x8 {
@@ -81,42 +87,30 @@ pub fn box_sum(sat: &SatView<'_>, u0: f32x8, v0: f32x8, u1: f32x8, v1: f32x8) ->
     } else {
         // The scalar kernel's sixteen entries per lane (`SatView::integer_terms`: rows `J0`,
         // `J1`, and `J + 1` where the fraction is non-zero, else `J` again; columns `I0`,
-        // `I0 + 1`, `I1`, `I1 + 1`; a row past the table reads as zeros), stored lane-major
-        // and loaded as sixteen `i64x8`, then its 27 wrapping subtractions lane-wise
+        // `I0 + 1`, `I1`, `I1 + 1`; a row past the table reads as zeros), loaded lane-wise
+        // into sixteen `i64x8`, then its 27 wrapping subtractions lane-wise
         // (wrapping `i64` arithmetic is exact modulo 2⁶⁴: the scalar terms, bit for bit).
         let (sums, w1, wl) = (sat.sums(), sat.width() + 1, sat.width() - 1);
+        // Row offsets, a row past the table at `len` (every entry of it then reads as 0,
+        // as the scalar kernel's row-wise check gives; rows are at most `height` for a
+        // valid view, so this only keeps the index arithmetic from overflowing).
+        let h1 = sat.height() + 1;
         let (bl0, bl1) = (b0.to_array(), b1.to_array());
-        let mut e = [[0i64; 8]; 16];
-        for k in 0..8 {
-            let (c0, c1) = (i0[k].min(wl), i1[k].min(wl));
-            let rows = [
-                j0[k],
-                j1[k],
-                if bl0[k] != 0.0 {
-                    j0[k].saturating_add(1)
-                } else {
-                    j0[k]
-                },
-                if bl1[k] != 0.0 {
-                    j1[k].saturating_add(1)
-                } else {
-                    j1[k]
-                },
-            ];
-            for (r, &l) in rows.iter().enumerate() {
-                let row = l
-                    .checked_mul(w1)
-                    .and_then(|s| sums.get(s..s.checked_add(w1)?));
-                let v = match row {
-                    Some(row) => [row[c0], row[c0 + 1], row[c1], row[c1 + 1]],
-                    None => [0; 4],
-                };
-                for (c, x) in v.into_iter().enumerate() {
-                    e[4 * r + c][k] = x;
-                }
-            }
-        }
-        let row = |r: usize| -> [i64x8; 4] { core::array::from_fn(|c| i64x8::new(e[4 * r + c])) };
+        let off = |l: usize| l.min(h1) * w1;
+        let next = |j: usize, b: f32| if b != 0.0 { j.saturating_add(1) } else { j };
+        let rows: [[usize; 8]; 4] = [
+            j0.map(off),
+            j1.map(off),
+            core::array::from_fn(|k| off(next(j0[k], bl0[k]))),
+            core::array::from_fn(|k| off(next(j1[k], bl1[k]))),
+        ];
+        let cols: [[usize; 8]; 2] = [i0.map(|i| i.min(wl)), i1.map(|i| i.min(wl))];
+        let load = |r: usize, c: usize, dc: usize| {
+            gather(sums, core::array::from_fn(|k| rows[r][k] + cols[c][k] + dc))
+        };
+        let row = |r: usize| -> [i64x8; 4] {
+            [load(r, 0, 0), load(r, 0, 1), load(r, 1, 0), load(r, 1, 1)]
+        };
         let (r0, r1, r0p, r1p) = (row(0), row(1), row(2), row(3));
         let d = |l: [i64x8; 4], m: [i64x8; 4]| -> [i64x8; 3] {
             [
