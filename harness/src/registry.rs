@@ -415,9 +415,12 @@ pub const KERNELS: &[KernelSpec] = &[
             "the ZXZXZ path has none; the built operator's twin (8 vectors per pass, \
              bit-identical) is steradian_simd::sh::rotate::apply_operator_slices",
         ),
+        // The twin of the scalar ZXZXZ path (each row its own rotation); the built
+        // operator's twin, `wgsl::SH_ROTATE` (one rotation for every row), is also listed
+        // under this name in `wgsl::CUSTOM`.
         wgsl: Piece::At(WgslTwin {
-            source: wgsl::SH_ROTATE,
-            tolerance: "steradian_core::wgsl::SH_ROTATE_TOL",
+            source: wgsl::SH_ROTATE_ZXZXZ,
+            tolerance: "steradian_core::wgsl::SH_ROTATE_ZXZXZ_TOL",
             table: Some("f32"),
         }),
         reference: Piece::At("steradian_reference::sh::rotate"),

@@ -190,6 +190,21 @@ impl Rotation {
     pub fn apply_to(&self, d: Vec3) -> Vec3 {
         (self.m * d.as_dvec3()).as_vec3()
     }
+
+    /// What [`rotate_zxzxz`] does for this rotation, as the seven `f32` values of a row of
+    /// the WGSL twin (`wgsl::SH_ROTATE_ZXZXZ`): `[mode, cos α, sin α, cos β, sin β, cos γ,
+    /// sin γ]`, mode 0 for a rotation about `z` (`Z(α)` alone), 1 for a half-turn about a
+    /// horizontal axis (`Z(α)·M(Ry(π))`), 2 for `Z(α)·Jᵀ·Z(β)·J·Z(γ)`; the unused angles
+    /// are 0 (`(1, 0)`). The exact cases stay exact on the GPU: no `J` block is applied.
+    pub fn gpu_row(&self) -> [f32; 7] {
+        let f = |c: [f64; 2]| [c[0] as f32, c[1] as f32];
+        let (mode, a, b, g) = match self.euler {
+            Euler::AboutZ(t) => (0.0, f(t), [1.0, 0.0], [1.0, 0.0]),
+            Euler::HalfTurn(t) => (1.0, f(t), [1.0, 0.0], [1.0, 0.0]),
+            Euler::General { alpha, beta, gamma } => (2.0, f(alpha), f(beta), f(gamma)),
+        };
+        [mode, a[0], a[1], b[0], b[1], g[0], g[1]]
+    }
 }
 
 /// The Euler decomposition `R = Rz(α)·Ry(β)·Rz(γ)` (module docs), with the exact cases.
@@ -643,6 +658,45 @@ mod tests {
                 Rotation::from_axis_angle(axis, 3.0 * r()).unwrap()
             })
             .collect()
+    }
+
+    #[test]
+    fn gpu_row_names_the_path_and_its_angles() {
+        // About z: mode 0 with (cos, sin) of the angle, the others (1, 0).
+        let r = Rotation::from_axis_angle(Vec3::Z, 0.5).unwrap().gpu_row();
+        assert_eq!(r[0], 0.0);
+        assert!((r[1] - 0.5f32.cos()).abs() < 1e-7 && (r[2] - 0.5f32.sin()).abs() < 1e-7);
+        assert_eq!(&r[3..], &[1.0, 0.0, 1.0, 0.0]);
+        // A half-turn about a horizontal axis (entries exactly 0 and −1): mode 1.
+        let h = Rotation::new([[1.0, 0.0, 0.0], [0.0, -1.0, 0.0], [0.0, 0.0, -1.0]]).unwrap();
+        assert_eq!(h.gpu_row()[0], 1.0);
+        // A general rotation: mode 2, three unit (cos, sin) pairs, and Z(α)·Ry(β)·Z(γ)
+        // rebuilds the matrix.
+        let g = Rotation::from_axis_angle(Vec3::new(0.3, -0.5, 0.8), 1.1).unwrap();
+        let r = g.gpu_row();
+        assert_eq!(r[0], 2.0);
+        for k in [1, 3, 5] {
+            assert!((r[k] * r[k] + r[k + 1] * r[k + 1] - 1.0).abs() < 1e-6);
+        }
+        let rz = |c: f32, s: f32| {
+            DMat3::from_cols(
+                DVec3::new(c.into(), s.into(), 0.0),
+                DVec3::new((-s).into(), c.into(), 0.0),
+                DVec3::Z,
+            )
+        };
+        let ry = DMat3::from_cols(
+            DVec3::new(r[3].into(), 0.0, (-r[4]).into()),
+            DVec3::Y,
+            DVec3::new(r[4].into(), 0.0, r[3].into()),
+        );
+        let m = rz(r[1], r[2]) * ry * rz(r[5], r[6]);
+        let d = m - g.matrix();
+        let worst = [d.x_axis, d.y_axis, d.z_axis]
+            .iter()
+            .map(|c| c.abs().max_element())
+            .fold(0.0, f64::max);
+        assert!(worst < 1e-6, "{worst}");
     }
 
     #[test]

@@ -254,6 +254,27 @@ pub const SH_ROTATE: &str = concat!(
 /// `tests/sh_gpu.rs`, which prints the largest difference).
 pub const SH_ROTATE_TOL: f32 = 1.0e-6;
 
+/// The ZXZXZ fast path of `sh-rotate` (`sh::rotate::rotate_zxzxz`) in `f32`, one
+/// coefficient vector and one rotation per invocation, up to [`SH_ROTATE_ZXZXZ_MAX_BANDS`]
+/// bands. Input: `bands²` coefficient columns, then the seven columns of
+/// `sh::rotate::Rotation::gpu_row`; output `bands²` columns; binding 3 is `[bands, blocks…]`
+/// (the blocks of `sh::rotate::x90_into`). Not in [`ALL`]. Tolerance:
+/// [`SH_ROTATE_ZXZXZ_TOL`].
+pub const SH_ROTATE_ZXZXZ: &str = concat!(
+    include_str!("batch.wgsl"),
+    include_str!("../sh/sh_rotate_zxzxz.wgsl")
+);
+/// Most bands of [`SH_ROTATE_ZXZXZ`] (its per-band scratch arrays hold 64 values; a table
+/// of more bands is read as 32).
+pub const SH_ROTATE_ZXZXZ_MAX_BANDS: usize = 32;
+/// Absolute difference allowed between [`SH_ROTATE_ZXZXZ`] and `sh::rotate::rotate_zxzxz`
+/// per coefficient, in units of the norm of the input's band: `f32` sums of up to 63 terms
+/// through two `J` blocks and `cos mθ`, `sin mθ` by angle addition. Lavapipe: `3.2e-7` at
+/// 10 bands, `7.3e-7` at 30 and 32, exact for band 0 and for rotations about `z` at
+/// `m = 0` (harness test `tests/sh_gpu.rs`, which prints the largest difference per band
+/// count).
+pub const SH_ROTATE_ZXZXZ_TOL: f32 = 5.0e-6;
+
 /// One HVL's contribution to one receiver per invocation (`sh::hvl::contribution` with
 /// `Horizon::Smoothstep`) in `f32`, for `n, n_e ≤ 16` bands: the geometry of
 /// `sh::hvl::prepare`, the emission and cap through the basis and cap factors of
@@ -410,12 +431,13 @@ pub const ALL: [(&str, &str); 5] = [
 
 /// The kernels outside [`ALL`], with a caller-supplied table at binding 3 (run them with
 /// the harness's custom kernels), as `(name, source, element type of the table)`.
-pub const CUSTOM: [(&str, &str, &str); 10] = [
+pub const CUSTOM: [(&str, &str, &str); 11] = [
     ("cp-query", CP_QUERY, "f32"),
     ("lobe-product", LOBE_PRODUCT, "f32"),
     ("sh-eval", SH_EVAL, "f32"),
     ("sh-cap", SH_CAP, "f32"),
     ("sh-irradiance", SH_IRRADIANCE, "f32"),
+    ("sh-rotate", SH_ROTATE_ZXZXZ, "f32"),
     ("sh-rotate", SH_ROTATE, "f32"),
     ("sat-box", SAT_BOX, "u32"),
     ("vdt-box", VDT_QUERY, "f32"),
