@@ -187,9 +187,18 @@ pub fn horizon_smoothstep(cos_theta: f32, a: f32) -> f32 {
 
 /// The exact fraction of a cap of half-angle `a ∈ [0, π/2]` above the horizon, its axis at
 /// the cosine `cos_theta` from the normal (module docs; `f64` inside).
+///
+/// The area of the cap above the horizon is `2(π(1 − cos a) − acos u + cos a·acos w)`
+/// with `u = c/sin a`, `w = c·cos a/(sin θ·sin a)` (module docs). For small caps the two
+/// `acos` nearly cancel, so it is rearranged without cancellation: with `R = √(sin²a − c²)`
+/// one finds `√(1 − u²) = R/sin a` and `√(1 − w²) = R/(sin θ·sin a)`, so
+/// `acos w = atan2(R, c·cos a)`, and `Δ = acos w − acos u` has
+/// `sin Δ ∝ c·R` and `cos Δ ∝ 1 + cos a − c²` (the same positive factor), whence the
+/// fraction `1 − acos(w)/π + Δ/(π(1 − cos a))`, every term at full relative precision
+/// (`1 − cos a = 2 sin²(a/2)`). For a small cap with `c = k·sin a` it tends to the flat
+/// disc's `1 − (acos k − k√(1 − k²))/π` (test below).
 pub fn horizon_exact(cos_theta: f32, a: f32) -> f32 {
     let (c, a) = (f64::from(cos_theta.clamp(-1.0, 1.0)), f64::from(a));
-    let s = math::sqrt64((1.0 - c * c).max(0.0));
     let (sa, ca) = (math::sin64(a), math::cos64(a));
     // Wholly above (θ ≤ π/2 − a ⇔ cos θ ≥ sin a) or below.
     if c >= sa {
@@ -198,22 +207,12 @@ pub fn horizon_exact(cos_theta: f32, a: f32) -> f32 {
     if -c >= sa {
         return 0.0;
     }
-    let u = (c / sa).clamp(-1.0, 1.0);
-    let w = if s > 0.0 {
-        (c * ca / (s * sa)).clamp(-1.0, 1.0)
-    } else {
-        0.0
-    };
+    let r = math::sqrt64((sa - c) * (sa + c));
+    let acos_w = math::atan2_64(r, c * ca);
+    let delta = math::atan2_64(c * r, 1.0 + ca - c * c);
     let one_minus_cos = 2.0 * math::sin64(0.5 * a) * math::sin64(0.5 * a);
     let pi = core::f64::consts::PI;
-    // The area of the cap ∩ the upper hemisphere (module docs), over the cap's area.
-    let above = 2.0 * (pi * one_minus_cos - acos64(u) + ca * acos64(w));
-    let cap = 2.0 * pi * one_minus_cos;
-    (above / cap).clamp(0.0, 1.0) as f32
-}
-
-fn acos64(x: f64) -> f64 {
-    math::atan2_64(math::sqrt64((1.0 - x * x).max(0.0)), x)
+    (1.0 - acos_w / pi + delta / (pi * one_minus_cos)).clamp(0.0, 1.0) as f32
 }
 
 /// The receiver of [`contribution`]: the shading point, its view frame
@@ -446,6 +445,23 @@ mod tests {
                 (f64::from(got) - want).abs() < 2e-3,
                 "a {a} θ {th}: {got} vs {want}"
             );
+        }
+    }
+
+    #[test]
+    fn the_exact_fraction_of_a_tiny_cap_is_the_flat_discs() {
+        // A cap of 1e-4 rad is a flat disc to 1e-8: the part above a line at signed
+        // distance k·(its radius) below its centre is 1 − (acos k − k√(1 − k²))/π. The
+        // rearranged form keeps this to f32 precision (in f32 arithmetic the textbook
+        // form's two nearly cancelling acos would lose every digit; `wgsl::SH_HVL_EXACT`
+        // computes in f32).
+        let a = 1e-4f64;
+        for k in [-0.999f64, -0.9, -0.5, -0.1, 0.0, 0.1, 0.5, 0.9, 0.999] {
+            let c = (k * a.sin()) as f32;
+            let k = f64::from(c) / a.sin();
+            let want = 1.0 - (k.acos() - k * (1.0 - k * k).sqrt()) / core::f64::consts::PI;
+            let got = f64::from(horizon_exact(c, a as f32));
+            assert!((got - want).abs() < 1e-6, "k {k}: {got} vs {want}");
         }
     }
 

@@ -1,5 +1,6 @@
 // steradian: one HVL's contribution to one receiver per invocation (mirrors
-// `sh::hvl::contribution` with the smoothstep horizon, in f32): the geometry of
+// `sh::hvl::contribution` with the smoothstep horizon, or the exact one where the prelude
+// sets HVL_EXACT_HORIZON, in f32): the geometry of
 // `sh::hvl::prepare`, the emission F′·Y(−ω_j) in the HVL's frame and the cap toward the HVL
 // in the receiver's frame dotted with its F (`sh_basis` and `sh_cap_scale` of
 // `sh_basis.wgsl`), then P·e·G·s.
@@ -18,6 +19,29 @@ fn col(k: u32, i: u32) -> f32 {
 // the digits the horizon term and the cap's half-angle need).
 fn asin_acc(x: f32) -> f32 {
     return atan2(x, sqrt((1.0 - x) * (1.0 + x)));
+}
+
+// The exact fraction of a cap of half-angle a (sin a = sa ∈ (0, 1]) above the horizon, its
+// axis at cos θ = c from the normal (`sh::hvl::horizon_exact`, the same cancellation-free
+// form): 1 − acos(w)/π + Δ/(π(1 − cos a)) with acos w = atan2(R, c·cos a),
+// Δ = atan2(c·R, 1 + cos a − c²), R = √((sa − c)(sa + c)), 1 − cos a = sa²/(1 + cos a). No
+// sin or cos of a (WGSL's lose the relative precision of small angles) and atan2_ of
+// `atan2.wgsl`, exact in relative terms for the small Δ of a small cap.
+fn horizon_exact(c: f32, sa: f32) -> f32 {
+    if (c >= sa) {
+        return 1.0;
+    }
+    if (-c >= sa) {
+        return 0.0;
+    }
+    let ca = sqrt((1.0 - sa) * (1.0 + sa));
+    let r = sqrt((sa - c) * (sa + c));
+    let acw = atan2_(r, c * ca);
+    let y = c * r;
+    let d = sign(y) * atan2_(abs(y), 1.0 + ca - c * c);
+    let omc = sa * sa / (1.0 + ca);
+    let pi = 3.14159265358979;
+    return clamp(1.0 - acw / pi + d / (pi * omc), 0.0, 1.0);
 }
 
 fn v3(at: u32) -> vec3<f32> {
@@ -61,10 +85,16 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
         output[i] = 0.0;
         return;
     }
-    let a = asin_acc(min(radius / d, 1.0));
+    let sa = min(radius / d, 1.0);
+    let a = asin_acc(sa);
     let c = clamp(dot(w, rn), -1.0, 1.0);
-    let t = clamp((a + asin_acc(c)) / (2.0 * a), 0.0, 1.0);
-    let h = t * t * (3.0 - 2.0 * t);
+    var h = 0.0;
+    if (HVL_EXACT_HORIZON) {
+        h = horizon_exact(c, sa);
+    } else {
+        let t = clamp((a + asin_acc(c)) / (2.0 * a), 0.0, 1.0);
+        h = t * t * (3.0 - 2.0 * t);
+    }
     if (h == 0.0) {
         output[i] = 0.0;
         return;

@@ -4,7 +4,7 @@
 //! batch layout below is written once, in `wgsl/batch.wgsl`, and prepended to every source,
 //! so each constant is a complete shader. Functions that several kernels use are written
 //! once too and concatenated into each of them: `wgsl/log1p.wgsl` (`log` without WGSL's
-//! `log`), `rsl/sat_lib.wgsl` (SAT box sums) and `rsl/vdt_lib.wgsl` (VDT queries).
+//! `log`), `wgsl/atan2.wgsl` (`atan2` with full relative precision), `rsl/sat_lib.wgsl` (SAT box sums) and `rsl/vdt_lib.wgsl` (VDT queries).
 //!
 //! ## Bindings (identical for every kernel)
 //!
@@ -287,15 +287,32 @@ pub const SH_ROTATE_ZXZXZ_TOL: f32 = 5.0e-6;
 /// `hvl_gpu_table`). Tolerance: [`SH_HVL_TOL`].
 pub const SH_HVL: &str = concat!(
     include_str!("batch.wgsl"),
+    include_str!("atan2.wgsl"),
     include_str!("../sh/sh_basis.wgsl"),
+    "const HVL_EXACT_HORIZON: bool = false;\n",
     include_str!("../sh/sh_hvl.wgsl")
 );
-/// Absolute difference allowed between [`SH_HVL`] and `sh::hvl::contribution`, per unit of
+/// [`SH_HVL`] with `Horizon::Exact`: the exact fraction of the cap above the receiver's
+/// horizon instead of the smoothstep `H` (`sh::hvl::horizon_exact`, in the
+/// cancellation-free form of its docs, with `sin a = r/d` and full-relative-precision
+/// `atan2`, so caps of `1e-4` rad keep their fraction). Same bindings. Tolerance:
+/// [`SH_HVL_TOL`].
+pub const SH_HVL_EXACT: &str = concat!(
+    include_str!("batch.wgsl"),
+    include_str!("atan2.wgsl"),
+    include_str!("../sh/sh_basis.wgsl"),
+    "const HVL_EXACT_HORIZON: bool = true;\n",
+    include_str!("../sh/sh_hvl.wgsl")
+);
+/// Absolute difference allowed between [`SH_HVL`] (and [`SH_HVL_EXACT`]) and
+/// `sh::hvl::contribution`, per unit of
 /// the largest `|contribution|` among the HVLs lighting the receiver (the horizon term's
 /// slope carries the GPU's trigonometry into the smallest contributions). The kernel's
 /// `asin` goes through `atan2` with `√((1 − x)(1 + x))`: lavapipe's own `asin` misses this
 /// tolerance near `|x| = 1`. Lavapipe: `7.3e-6` over 2000 random
-/// HVLs at 1–14 bands (harness test `tests/sh_gpu.rs`, which prints them).
+/// HVLs at 1–14 bands, for both horizons, and `4.3e-5` of their own value for 200 caps of
+/// `1e-4`–`1e-2` rad straddling the horizon (harness test `tests/sh_gpu.rs`, which prints
+/// them and asserts `2e-4` for those).
 pub const SH_HVL_TOL: f32 = 2.0e-5;
 
 /// The irradiance of one radiance vector at many normals (`sh::irradiance::irradiance`) in
@@ -406,6 +423,7 @@ pub const SHADE_MOMENTS_REL_TOL: f32 = 1.0e-5;
 pub const LOBE_PRODUCT: &str = concat!(
     include_str!("batch.wgsl"),
     include_str!("log1p.wgsl"),
+    include_str!("atan2.wgsl"),
     include_str!("../lobe/product.wgsl")
 );
 /// Difference allowed between [`LOBE_PRODUCT`] and `product::product_with`

@@ -107,7 +107,7 @@ pub struct Gpu {
     info: wgpu::AdapterInfo,
     layout: wgpu::BindGroupLayout,
     layout_table: wgpu::BindGroupLayout,
-    pipelines: HashMap<&'static str, wgpu::ComputePipeline>,
+    pipelines: HashMap<(&'static str, usize, usize), wgpu::ComputePipeline>,
     params: wgpu::Buffer,
     table: wgpu::Buffer,
     /// The caller's table of a [`Custom`] kernel.
@@ -355,7 +355,10 @@ impl Gpu {
 
     /// The pipeline of `job`, compiled on first use.
     fn pipeline(&mut self, job: &Job) -> Result<wgpu::ComputePipeline, BackendError> {
-        if let Some(p) = self.pipelines.get(job.label) {
+        // Keyed by the label and the source itself (its address and length): two sources
+        // under one label are two pipelines.
+        let key = (job.label, job.source.as_ptr() as usize, job.source.len());
+        if let Some(p) = self.pipelines.get(&key) {
             return Ok(p.clone());
         }
         let (kernel, src) = (job.label, job.source);
@@ -385,7 +388,7 @@ impl Gpu {
             })
         })?;
         self.take_uncaptured()?;
-        self.pipelines.insert(kernel, pipeline.clone());
+        self.pipelines.insert(key, pipeline.clone());
         Ok(pipeline)
     }
 
