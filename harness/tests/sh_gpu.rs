@@ -190,6 +190,53 @@ fn sh_irradiance_gpu_matches_scalar() {
     ));
 }
 
+/// `n²`-long coefficient vectors as the first `n²` columns of a batch, with `extra` more
+/// columns (zeros) after them.
+fn vector_columns(vectors: &[Vec<f32>], nn: usize, extra: usize) -> Columns {
+    let count = vectors.len();
+    let mut input = Columns::zeros(nn + extra, count);
+    for (i, v) in vectors.iter().enumerate() {
+        for (k, x) in v.iter().enumerate() {
+            input.data[k * count + i] = *x;
+        }
+    }
+    input
+}
+
+/// A GPU rotation's output columns against the scalar kernel's `want(i, vector, out)` for
+/// every vector, each coefficient within `tol` of its input band's norm; the largest
+/// difference in those units.
+fn rotation_error(
+    what: &str,
+    vectors: &[Vec<f32>],
+    bands: usize,
+    out: &Columns,
+    tol: f32,
+    mut want: impl FnMut(usize, &[f32], &mut [f32]),
+) -> f32 {
+    let (count, nn) = (vectors.len(), bands * bands);
+    let mut w = vec![0.0f32; nn];
+    let mut worst = 0.0f32;
+    for (i, v) in vectors.iter().enumerate() {
+        want(i, v, &mut w);
+        for l in 0..bands {
+            let band = l * l..(l + 1) * (l + 1);
+            let norm = v[band.clone()].iter().map(|x| x * x).sum::<f32>().sqrt();
+            for k in band {
+                let got = out.data[k * count + i];
+                let err = (got - w[k]).abs() / norm.max(f32::MIN_POSITIVE);
+                worst = worst.max(err);
+                assert!(
+                    err <= tol,
+                    "{what}, {bands} bands, vector {i}, coefficient {k}: gpu {got} vs scalar {} ({err:e} of the band's norm)",
+                    w[k]
+                );
+            }
+        }
+    }
+    worst
+}
+
 #[test]
 fn sh_rotate_gpu_matches_scalar() {
     let Some(mut g) = gpu() else { return };
@@ -203,12 +250,7 @@ fn sh_rotate_gpu_matches_scalar() {
         let vectors: Vec<Vec<f32>> = (0..count)
             .map(|_| (0..nn).map(|_| rng.range(-2.0, 2.0) as f32).collect())
             .collect();
-        let mut input = Columns::zeros(nn, count);
-        for (i, v) in vectors.iter().enumerate() {
-            for (k, x) in v.iter().enumerate() {
-                input.data[k * count + i] = *x;
-            }
-        }
+        let input = vector_columns(&vectors, nn, 0);
         let mut table = vec![bands as f32];
         table.extend_from_slice(op.blocks());
         let mut out = Columns::zeros(nn, count);
@@ -219,26 +261,14 @@ fn sh_rotate_gpu_matches_scalar() {
         };
         g.run_custom(&custom, &input, &mut out)
             .expect("SH rotation kernel runs");
-        let mut want = vec![0.0f32; nn];
-        let mut worst = 0.0f32;
-        for (i, v) in vectors.iter().enumerate() {
-            op.apply(v, &mut want).unwrap();
-            for l in 0..bands {
-                let band = l * l..(l + 1) * (l + 1);
-                let norm = v[band.clone()].iter().map(|x| x * x).sum::<f32>().sqrt();
-                for k in band {
-                    let err =
-                        (out.data[k * count + i] - want[k]).abs() / norm.max(f32::MIN_POSITIVE);
-                    worst = worst.max(err);
-                    assert!(
-                        err <= wgsl::SH_ROTATE_TOL,
-                        "{bands} bands, vector {i}, coefficient {k}: gpu {} vs scalar {} ({err:e} of the band's norm)",
-                        out.data[k * count + i],
-                        want[k]
-                    );
-                }
-            }
-        }
+        let worst = rotation_error(
+            "operator",
+            &vectors,
+            bands,
+            &out,
+            wgsl::SH_ROTATE_TOL,
+            |_, v, w| op.apply(v, w).unwrap(),
+        );
         worst_by_bands.push((bands, worst));
     }
     say(&format!(
@@ -282,11 +312,8 @@ fn sh_rotate_zxzxz_gpu_matches_scalar() {
         let vectors: Vec<Vec<f32>> = (0..count)
             .map(|_| (0..nn).map(|_| rng.range(-2.0, 2.0) as f32).collect())
             .collect();
-        let mut input = Columns::zeros(nn + 7, count);
-        for (i, v) in vectors.iter().enumerate() {
-            for (k, x) in v.iter().enumerate() {
-                input.data[k * count + i] = *x;
-            }
+        let mut input = vector_columns(&vectors, nn, 7);
+        for i in 0..count {
             for (k, x) in rots[i % rots.len()].gpu_row().iter().enumerate() {
                 input.data[(nn + k) * count + i] = *x;
             }
@@ -304,29 +331,18 @@ fn sh_rotate_zxzxz_gpu_matches_scalar() {
         };
         g.run_custom(&custom, &input, &mut out)
             .expect("SH ZXZXZ rotation kernel runs");
-        let mut want = vec![0.0f32; nn];
-        let mut worst = 0.0f32;
+        let worst = rotation_error(
+            "ZXZXZ",
+            &vectors,
+            bands,
+            &out,
+            wgsl::SH_ROTATE_ZXZXZ_TOL,
+            |i, v, w| rotate_zxzxz(&blocks, &rots[i % rots.len()], bands, v, w).unwrap(),
+        );
+        // The exact cases stay exact in structure: about z, every m = 0 coefficient is
+        // unchanged (bit for bit, no J block is applied).
         for (i, v) in vectors.iter().enumerate() {
-            let rot = &rots[i % rots.len()];
-            rotate_zxzxz(&blocks, rot, bands, v, &mut want).unwrap();
-            for l in 0..bands {
-                let band = l * l..(l + 1) * (l + 1);
-                let norm = v[band.clone()].iter().map(|x| x * x).sum::<f32>().sqrt();
-                for k in band {
-                    let got = out.data[k * count + i];
-                    let err = (got - want[k]).abs() / norm.max(f32::MIN_POSITIVE);
-                    worst = worst.max(err);
-                    assert!(
-                        err <= wgsl::SH_ROTATE_ZXZXZ_TOL,
-                        "{bands} bands, vector {i} ({:?}), coefficient {k}: gpu {got} vs scalar {} ({err:e} of the band's norm)",
-                        rot.gpu_row(),
-                        want[k]
-                    );
-                }
-            }
-            // The exact cases stay exact in structure: about z, band 0 and every m = 0
-            // coefficient are unchanged (bit for bit, no J block is applied).
-            if rot.gpu_row()[0] == 0.0 {
+            if rots[i % rots.len()].gpu_row()[0] == 0.0 {
                 for l in 0..bands {
                     let k = l * l + l;
                     assert_eq!(out.data[k * count + i], v[k], "about z, m = 0 of band {l}");
