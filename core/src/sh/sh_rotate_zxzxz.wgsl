@@ -3,8 +3,8 @@
 // Input: bands² coefficient columns (coefficient k of row i at k·n + i), then the seven
 // columns of `sh::rotate::Rotation::gpu_row` ([mode, cos α, sin α, cos β, sin β, cos γ,
 // sin γ]); output: bands² columns. The table (binding 3) is [bands, the blocks of
-// `sh::rotate::x90_into`] (block l: (2l+1)² row-major entries from offset 1 + l·(4l²−1)/3),
-// bands ≤ 32.
+// `sh::rotate::x90_into`] (block l: (2l+1)² row-major entries from offset 1 + l·(4l²−1)/3);
+// bands from 32 on come out NaN.
 //
 // Per band l, as the scalar kernel: mode 0 is Z(α); mode 1 multiplies by (−1)^l, and −1
 // more for m < 0 (M(Ry(π))), then Z(α); mode 2 is Z(γ), J, Z(β), Jᵀ, Z(α). Z(θ) turns each
@@ -61,7 +61,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     if (i >= n) {
         return;
     }
-    let bands = min(u32(table[0]), 32u);
+    let bands = u32(table[0]);
     let nn = bands * bands;
     let mode = input[nn * n + i];
     let ca = input[(nn + 1u) * n + i];
@@ -75,6 +75,14 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     for (var l = 0u; l < bands; l++) {
         let w = 2u * l + 1u;
         let first = l * l;
+        if (l >= 32u) {
+            // Past the supported bands (the scratch arrays' size): NaN, not a silently
+            // missing band.
+            for (var t = 0u; t < w; t++) {
+                output[(first + t) * n + i] = bitcast<f32>(0x7fc00000u);
+            }
+            continue;
+        }
         for (var t = 0u; t < w; t++) {
             a[t] = input[(first + t) * n + i];
         }

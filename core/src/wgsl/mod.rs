@@ -243,11 +243,16 @@ pub const SH_CAP_TOL: f32 = 1.0e-5;
 /// The built SH rotation operator (`sh::rotate::apply_operator`, the many-vectors path of
 /// `sh-rotate`) applied to one coefficient vector per invocation, in `f32` as on the CPU.
 /// Input and output: `bands²` columns; binding 3 is `[bands, blocks…]` (the blocks of
-/// `sh::rotate::Operator::blocks`). Not in [`ALL`]. Tolerance: [`SH_ROTATE_TOL`].
+/// `sh::rotate::Operator::blocks`); bands from [`SH_ROTATE_MAX_BANDS`] on come out NaN. Not
+/// in [`ALL`]. Tolerance: [`SH_ROTATE_TOL`].
 pub const SH_ROTATE: &str = concat!(
     include_str!("batch.wgsl"),
     include_str!("../sh/sh_rotate.wgsl")
 );
+/// Most bands of [`SH_ROTATE`]: lavapipe ends a shader's loops after about 65 000
+/// iterations in all, which the sums of 36 bands pass (harness test `tests/sh_gpu.rs`
+/// checks 32 bands and NaN from there on).
+pub const SH_ROTATE_MAX_BANDS: usize = 32;
 /// Absolute difference allowed between [`SH_ROTATE`] and `sh::rotate::apply_operator` per
 /// coefficient, in units of the norm of the input's band (a GPU may fuse the sums'
 /// multiply-adds). Lavapipe: bit-identical through 30 bands (harness test
@@ -264,8 +269,8 @@ pub const SH_ROTATE_ZXZXZ: &str = concat!(
     include_str!("batch.wgsl"),
     include_str!("../sh/sh_rotate_zxzxz.wgsl")
 );
-/// Most bands of [`SH_ROTATE_ZXZXZ`] (its per-band scratch arrays hold 64 values; a table
-/// of more bands is read as 32).
+/// Most bands of [`SH_ROTATE_ZXZXZ`] (its per-band scratch arrays hold 64 values); bands
+/// from there on come out NaN.
 pub const SH_ROTATE_ZXZXZ_MAX_BANDS: usize = 32;
 /// Absolute difference allowed between [`SH_ROTATE_ZXZXZ`] and `sh::rotate::rotate_zxzxz`
 /// per coefficient, in units of the norm of the input's band: `f32` sums of up to 63 terms
