@@ -405,6 +405,67 @@ fn visibility_map_texel_coverage() {
     assert!(worst < 1e-3, "{worst}");
 }
 
+/// Coverage with fewer subdivision levels (`coverage_into_depth`): `LEAF_DEPTH` is
+/// `coverage_into` bit for bit, more is an error, and the worst boundary texel and the
+/// visible solid angle stay within the bounds documented for each depth.
+#[test]
+fn visibility_map_coverage_by_depth() {
+    let caps = vec![
+        SphericalCap::new(Vec3::new(0.3, 0.2, 0.9), 0.4).unwrap(),
+        SphericalCap::new(Vec3::new(-0.7, 0.1, 0.3), 0.5).unwrap(),
+        SphericalCap::new(Vec3::new(0.1, -0.9, 0.2), 0.05).unwrap(),
+    ];
+    let exact_sa = visible_solid_angle_polar(&caps, 400_000);
+    let n = 32;
+    let mut full = vec![0.0f32; n * n];
+    visibility::coverage_into(&caps, n, Outside::Visible, &mut full).unwrap();
+    let mut cov = vec![0.0f32; n * n];
+    visibility::coverage_into_depth(&caps, n, Outside::Visible, visibility::LEAF_DEPTH, &mut cov)
+        .unwrap();
+    assert!(
+        cov.iter()
+            .zip(&full)
+            .all(|(a, b)| a.to_bits() == b.to_bits())
+    );
+    assert!(
+        visibility::coverage_into_depth(
+            &caps,
+            n,
+            Outside::Visible,
+            visibility::LEAF_DEPTH + 1,
+            &mut cov
+        )
+        .is_err()
+    );
+    // Dense references of the boundary texels, once.
+    let boundary: Vec<(usize, f64)> = (0..n * n)
+        .filter(|&k| full[k] > 0.0 && full[k] < 1.0)
+        .map(|k| {
+            let (i, j) = ((k % n) as f64, (k / n) as f64);
+            (
+                k,
+                caps_visible_area(&caps, n, [i, j, i + 1.0, j + 1.0], 256),
+            )
+        })
+        .collect();
+    assert!(boundary.len() > 40);
+    for depth in 0..=visibility::LEAF_DEPTH {
+        let mut occ = vec![0.0f32; n * n];
+        visibility::coverage_into_depth(&caps, n, Outside::Occluded, depth, &mut occ).unwrap();
+        let sa = visibility::visible_solid_angle(&occ, n);
+        let sa_rel = (sa - exact_sa).abs() / exact_sa;
+        visibility::coverage_into_depth(&caps, n, Outside::Visible, depth, &mut cov).unwrap();
+        let worst = boundary
+            .iter()
+            .map(|&(k, a)| (cov[k] as f64 - a).abs())
+            .fold(0.0, f64::max);
+        eprintln!("depth {depth}: worst texel {worst:.2e}, solid angle rel {sa_rel:.2e}");
+        let (texel_bound, sa_bound) = visibility::DEPTH_BOUNDS[depth as usize];
+        assert!(worst < texel_bound as f64, "depth {depth}: {worst}");
+        assert!(sa_rel < sa_bound as f64, "depth {depth}: {sa_rel}");
+    }
+}
+
 #[test]
 fn eval_good_and_bad_lines() {
     let v = eval_vdt_box(

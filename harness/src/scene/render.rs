@@ -132,7 +132,7 @@ pub struct Plan {
 pub fn plan(scene: &Scene, o: &Options) -> Result<Plan, String> {
     let mut p = Vec::new();
     let mut lo = lobes::Options::default();
-    let r = super::rsl::Options::default();
+    let mut r = super::rsl::Options::default();
     let mut hv = super::hvl::Options::default();
     match o.method {
         Method::Path => {
@@ -173,6 +173,22 @@ pub fn plan(scene: &Scene, o: &Options) -> Result<Plan, String> {
                     r.vis_side
                 )),
                 reason: "caps of the other spheres and the planes the point is not on".into(),
+            });
+            // The coarsest coverage whose visible solid angle is within a tenth of the
+            // target (the asserted bounds of `DEPTH_BOUNDS`).
+            use steradian_core::rsl::visibility::{DEPTH_BOUNDS, LEAF_DEPTH};
+            r.vis_depth = (0..=LEAF_DEPTH)
+                .find(|&d| (DEPTH_BOUNDS[d as usize].1 as f64) <= o.target_error / 10.0)
+                .unwrap_or(LEAF_DEPTH);
+            p.push(PlanItem {
+                item: "coverage_depth".into(),
+                value: json!(r.vis_depth),
+                reason: format!(
+                    "subdivision levels below a visibility texel: the coarsest whose visible \
+                     solid angle is within {:.1e} relative (a tenth of the target error {})",
+                    DEPTH_BOUNDS[r.vis_depth as usize].1,
+                    o.target_error
+                ),
             });
             if !scene.lights.is_empty() {
                 p.push(PlanItem {

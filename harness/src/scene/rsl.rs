@@ -26,7 +26,7 @@ use steradian_core::lobe::cap::SphericalCap;
 use steradian_core::rsl::brdf_sat::BrdfSat;
 use steradian_core::rsl::shade::{self, ShadeLight};
 use steradian_core::rsl::vis_moments::VisMoments;
-use steradian_core::rsl::visibility::{Outside, coverage_into, local_cap};
+use steradian_core::rsl::visibility::{Outside, coverage_into_depth, local_cap};
 
 use super::image::Image;
 use super::material::Material;
@@ -45,6 +45,9 @@ pub struct Options {
     pub vis_side: usize,
     /// Target error of the BRDF SAT fits ([`BrdfSat::fit`]).
     pub sat_target: f32,
+    /// Subdivision levels below a visibility texel
+    /// ([`steradian_core::rsl::visibility::coverage_into_depth`]).
+    pub vis_depth: u32,
 }
 
 impl Default for Options {
@@ -54,6 +57,7 @@ impl Default for Options {
             face: 32,
             vis_side: 32,
             sat_target: 0.005,
+            vis_depth: 2,
         }
     }
 }
@@ -155,7 +159,7 @@ pub fn shade_point(
             }
         }
     }
-    if coverage_into(&caps, o.vis_side, Outside::Visible, cov).is_err() {
+    if coverage_into_depth(&caps, o.vis_side, Outside::Visible, o.vis_depth, cov).is_err() {
         return [0.0; 3];
     }
     let Ok(moments) = VisMoments::build_coverage(o.vis_side, cov) else {
