@@ -473,3 +473,39 @@ fn rsl_method_against_the_path_tracer_on_a_small_environment_scene() {
         "{m:?}"
     );
 }
+
+/// The noise-corrected relative L2 recovers a method's error against the noise-free image
+/// from a noisy reference with known standard errors, where the plain one is dominated by
+/// the noise; without standard errors both agree.
+#[test]
+fn noise_corrected_rel_l2_removes_the_reference_noise() {
+    let (w, h) = (128, 128);
+    let mut rng = Rng::new(7);
+    let mut truth = Image::new(w, h);
+    let mut reference = Image::new(w, h);
+    let mut stderr = Image::new(w, h);
+    let mut method = Image::new(w, h);
+    for k in 0..w * h {
+        for c in 0..3 {
+            let t = 0.2 + 0.8 * rng.unit();
+            let sigma = 0.02 * t;
+            // A normal deviate by Box–Muller.
+            let (u1, u2) = (rng.unit().max(1e-300), rng.unit());
+            let z = (-2.0 * u1.ln()).sqrt() * (TAU * u2).cos();
+            truth.data[k][c] = t;
+            reference.data[k][c] = t + sigma * z;
+            stderr.data[k][c] = sigma;
+            method.data[k][c] = t * if (k + c) % 2 == 0 { 1.01 } else { 0.99 };
+        }
+    }
+    let class = vec![Some(true); w * h];
+    let exact = metrics::compare(&class, &method, &truth, None, 0.0).unwrap();
+    let noisy = metrics::compare(&class, &method, &reference, Some(&stderr), 0.0).unwrap();
+    eprintln!(
+        "exact {:.4e}, noisy plain {:.4e}, corrected {:.4e}",
+        exact.rel_l2, noisy.rel_l2, noisy.rel_l2_noise_corrected
+    );
+    assert_eq!(exact.rel_l2, exact.rel_l2_noise_corrected);
+    assert!(noisy.rel_l2 > 2.0 * exact.rel_l2);
+    assert!((noisy.rel_l2_noise_corrected / exact.rel_l2 - 1.0).abs() < 0.1);
+}

@@ -4,7 +4,8 @@
 //! path tracer would need N× longer for the same error".
 //!
 //! Per scene of [`SCENES`] (at [`WIDTH`] columns): the reference is the path tracer at
-//! [`REFERENCE_SPP`] samples per pixel (direct light for `lobes` and `cluster`, one bounce
+//! [`REFERENCE_SPP`] samples per pixel ([`ENVIRONMENT_REFERENCE_SPP`] for `environment`,
+//! whose reference is the noisiest per sample) (direct light for `lobes` and `cluster`, one bounce
 //! for `room`); the path tracer's curve is the same tracer with other seeds at 1–64
 //! samples. The `lobes` method's curve is its pruning threshold, with the L2 cap fit and
 //! one lobe per occluder (instead of the default energy-preserving fit and quadtree mask)
@@ -35,15 +36,26 @@ use crate::scene::{Scene, hvl, lobes, path, rsl};
 pub const WIDTH: u32 = 96;
 /// Samples per pixel of the reference.
 pub const REFERENCE_SPP: u32 = 512;
+/// Samples per pixel of the `environment` reference: at 512 its noise (about 1.2 % of the
+/// maximum radiance) hid the `rsl` method's error from K = 100 on.
+pub const ENVIRONMENT_REFERENCE_SPP: u32 = 4096;
+
+/// The reference's samples per pixel for a scene.
+fn reference_spp(name: &str) -> u32 {
+    if name == "environment" {
+        ENVIRONMENT_REFERENCE_SPP
+    } else {
+        REFERENCE_SPP
+    }
+}
 /// The path tracer's own curve.
 const PATH_SPP: &[u32] = &[1, 2, 4, 8, 16, 64];
 /// Pruning thresholds of the `lobes` curve.
 const THRESHOLDS: &[f32] = &[0.0, 1e-4, 1e-3, 1e-2, 5e-2];
 /// Reflective-shadow-map face sides of the `hvl` curve.
 const HVL_SIDES: &[usize] = &[2, 4, 8, 12];
-/// Square-light counts of the `rsl` curve (one point: its cost is the per-point
-/// visibility tables, whatever `K`; the report's `shade` section measures `K`).
-const RSL_KS: &[usize] = &[30];
+/// Square-light counts of the `rsl` curve (the paper's Figures 9–10 use 10–100).
+const RSL_KS: &[usize] = &[10, 30, 100, 300];
 
 /// One point of a curve.
 #[derive(Clone, Debug)]
@@ -52,6 +64,9 @@ struct Point {
     seconds: f64,
     metrics: Metrics,
     products_per_pixel: Option<f64>,
+    /// Seconds of one-time precomputation not in `seconds` (`rsl`: decomposition and
+    /// BRDF tables).
+    build_seconds: Option<f64>,
 }
 
 /// One scene's measurements.
@@ -78,19 +93,25 @@ fn timed<T>(f: impl FnOnce() -> T) -> (T, f64) {
     (v, t.elapsed().as_secs_f64())
 }
 
-/// The path tracer's seconds at `err`, interpolated log–log on its curve (extrapolated
-/// with slope −2 in time per decade of error beyond its ends).
-fn path_seconds_at(curve: &[Point], err: f64) -> f64 {
+/// The path tracer's seconds at `err` of the measure `m`, interpolated log–log on its
+/// curve (extrapolated with slope −2 in time per decade of error beyond its ends); `None`
+/// when `err` or a curve point is not positive (a noise-corrected error below the
+/// reference's resolution).
+fn path_seconds_at(curve: &[Point], err: f64, m: fn(&Metrics) -> f64) -> Option<f64> {
+    let positive = |v: f64| v > 0.0;
+    if !positive(err) || curve.iter().any(|p| !positive(m(&p.metrics))) || curve.is_empty() {
+        return None;
+    }
     let pts: Vec<(f64, f64)> = curve
         .iter()
-        .map(|p| (p.metrics.mean_abs_over_max.ln(), p.seconds.ln()))
+        .map(|p| (m(&p.metrics).ln(), p.seconds.ln()))
         .collect();
     let e = err.ln();
     for w in pts.windows(2) {
         let ((e0, t0), (e1, t1)) = (w[0], w[1]);
         if (e <= e0 && e >= e1) || (e >= e0 && e <= e1) {
             let f = if e1 == e0 { 0.0 } else { (e - e0) / (e1 - e0) };
-            return (t0 + f * (t1 - t0)).exp();
+            return Some((t0 + f * (t1 - t0)).exp());
         }
     }
     // Beyond the curve: error ∝ spp^−½ ∝ time^−½.
@@ -99,7 +120,21 @@ fn path_seconds_at(curve: &[Point], err: f64) -> f64 {
     } else {
         pts[0]
     };
-    (t_end - 2.0 * (e - e_end)).exp()
+    Some((t_end - 2.0 * (e - e_end)).exp())
+}
+
+/// The two measures the equal-error cost is read on.
+fn mean_abs(m: &Metrics) -> f64 {
+    m.mean_abs_over_max
+}
+fn rel_l2_corrected(m: &Metrics) -> f64 {
+    m.rel_l2_noise_corrected
+}
+
+/// The path tracer's time at a point's error over the point's time, on both measures.
+fn cost_ratios(path: &[Point], p: &Point) -> (Option<f64>, Option<f64>) {
+    let r = |m: fn(&Metrics) -> f64| path_seconds_at(path, m(&p.metrics), m).map(|t| t / p.seconds);
+    (r(mean_abs), r(rel_l2_corrected))
 }
 
 /// A method's render under one setting: the image and its kernel products per pixel.
@@ -110,6 +145,8 @@ struct Setting<'a> {
     label: String,
     render: Render<'a>,
     default: bool,
+    /// Seconds of precomputation done before the timed render, if any.
+    build_seconds: Option<f64>,
 }
 
 fn lobes_settings(scene: &Scene) -> (Vec<Setting<'_>>, Vec<Setting<'_>>) {
@@ -122,6 +159,7 @@ fn lobes_settings(scene: &Scene) -> (Vec<Setting<'_>>, Vec<Setting<'_>>) {
             (img, Some(c.computed as f64 / px))
         }),
         default,
+        build_seconds: None,
     };
     let curve = THRESHOLDS
         .iter()
@@ -160,6 +198,7 @@ fn hvl_settings(scene: &Scene) -> (Vec<Setting<'_>>, Vec<Setting<'_>>) {
         label,
         render: Box::new(move || (hvl::render(scene, &o, &ProgressBar::hidden()).0, None)),
         default,
+        build_seconds: None,
     };
     let curve = HVL_SIDES
         .iter()
@@ -192,6 +231,7 @@ fn hvl_settings(scene: &Scene) -> (Vec<Setting<'_>>, Vec<Setting<'_>>) {
                 (img, Some(c.computed as f64 / px))
             }),
             default: false,
+            build_seconds: None,
         },
     ];
     (curve, variants)
@@ -201,16 +241,23 @@ fn rsl_settings(scene: &Scene) -> (Vec<Setting<'_>>, Vec<Setting<'_>>) {
     let d = rsl::Options::default();
     let curve = RSL_KS
         .iter()
-        .map(|&k| Setting {
-            label: format!("K = {k}"),
-            render: Box::new(move || {
-                let img = rsl::render(scene, &rsl::Options { k, ..d }, &ProgressBar::hidden())
-                    .unwrap_or_else(|_| {
-                        Image::new(scene.camera.width as usize, scene.camera.height as usize)
-                    });
-                (img, None)
-            }),
-            default: k == d.k,
+        .map(|&k| {
+            let o = rsl::Options { k, ..d };
+            let (built, build_seconds) = timed(|| rsl::build(scene, &o));
+            Setting {
+                label: format!("K = {k}"),
+                render: Box::new(move || {
+                    let img = match &built {
+                        Ok(b) => rsl::render_built(scene, b, &o, &ProgressBar::hidden()),
+                        Err(_) => {
+                            Image::new(scene.camera.width as usize, scene.camera.height as usize)
+                        }
+                    };
+                    (img, None)
+                }),
+                default: k == d.k,
+                build_seconds: Some(build_seconds),
+            }
         })
         .collect();
     (curve, Vec::new())
@@ -238,7 +285,7 @@ fn measure_scene(
     let hidden = ProgressBar::hidden();
     let settings = |spp, seed| path::Settings { spp, bounces, seed };
     let (reference, reference_seconds) =
-        timed(|| path::render(&scene, &settings(REFERENCE_SPP, 1), &hidden));
+        timed(|| path::render(&scene, &settings(reference_spp(name), 1), &hidden));
     bar.inc(1);
     let class = metrics::classify(&scene);
     let compare =
@@ -251,6 +298,7 @@ fn measure_scene(
             seconds: s,
             metrics: compare(&out.image)?,
             products_per_pixel: None,
+            build_seconds: None,
         });
     }
     bar.inc(1);
@@ -277,6 +325,7 @@ fn measure_scene(
                 seconds: best,
                 metrics: compare(&img)?,
                 products_per_pixel: products,
+                build_seconds: st.build_seconds,
             },
             img,
         ))
@@ -296,7 +345,7 @@ fn measure_scene(
         .collect::<Result<Vec<_>, _>>()?;
     bar.inc(1);
     let (dp, dimg) = default_img.ok_or("the default setting is on the curve")?;
-    let equal_error_ratio = path_seconds_at(&path_curve, dp.metrics.mean_abs_over_max) / dp.seconds;
+    let equal_error_ratio = cost_ratios(&path_curve, &dp).0.unwrap_or(f64::NAN);
     let diff = metrics::difference_image(
         &class,
         &dimg,
@@ -329,8 +378,18 @@ fn point_json(p: &Point) -> serde_json::Value {
         "setting": p.setting,
         "seconds": p.seconds,
         "products_per_pixel": p.products_per_pixel,
+        "build_seconds": p.build_seconds,
         "errors": p.metrics,
     })
+}
+
+/// A method's point with its equal-error cost ratios against the path tracer's curve.
+fn method_point_json(path: &[Point], p: &Point) -> serde_json::Value {
+    let (a, l2) = cost_ratios(path, p);
+    let mut v = point_json(p);
+    v["equal_error_cost_ratio"] = json!(a);
+    v["equal_error_cost_ratio_rel_l2"] = json!(l2);
+    v
 }
 
 fn plot(r: &SceneResult) -> String {
@@ -379,7 +438,7 @@ pub fn section(_opts: &Options) -> Result<Section, Box<dyn Error>> {
     writeln!(
         html,
         "<p>Built-in scenes at {WIDTH} columns. Reference: the path tracer at {REFERENCE_SPP} \
-         samples per pixel (direct light; one bounce for <code>room</code>). Errors over shaded, \
+         samples per pixel ({ENVIRONMENT_REFERENCE_SPP} on <code>environment</code>; direct light; one bounce for <code>room</code>). Errors over shaded, \
          non-silhouette pixels (see the README, \"Errors\"); times are whole renders on this \
          machine's thread pool, the best of three for the methods.</p>"
     )?;
@@ -413,6 +472,23 @@ pub fn section(_opts: &Options) -> Result<Section, Box<dyn Error>> {
             d.metrics.reference_noise_over_max,
             r.equal_error_ratio
         )?;
+        // The best equal-error cost over the method's curve, on each measure.
+        let best = |k: usize| {
+            r.curve
+                .iter()
+                .filter_map(|p| {
+                    let c = cost_ratios(&r.path, p);
+                    [c.0, c.1][k].map(|v| (v, p.setting.as_str()))
+                })
+                .max_by(|a, b| a.0.total_cmp(&b.0))
+                .map_or("–".to_string(), |(v, s)| format!("{v:.1}× ({s})"))
+        };
+        writeln!(
+            summary,
+            "    best equal-error cost ratio over the curve: {} on mean |diff|, {} on noise-corrected rel L2",
+            best(0),
+            best(1)
+        )?;
         writeln!(
             html,
             "<h3>{} ({})</h3><p>{}×{}; reference {:.1} s. The path tracer needs {:.1}× the time of \
@@ -428,7 +504,7 @@ pub fn section(_opts: &Options) -> Result<Section, Box<dyn Error>> {
             r.equal_error_ratio,
             d.setting
         )?;
-        html.push_str("<table><tr><th>method</th><th>setting</th><th>s</th><th>mean |diff|/max</th><th>rel L2</th><th>RMSE</th><th>PSNR dB</th><th>SSIM</th><th>products/px</th></tr>");
+        html.push_str("<table><tr><th>method</th><th>setting</th><th>s</th><th>mean |diff|/max</th><th>rel L2</th><th>rel L2, noise-corrected</th><th>RMSE</th><th>PSNR dB</th><th>SSIM</th><th>products/px</th></tr>");
         for (m, p) in r
             .path
             .iter()
@@ -437,11 +513,12 @@ pub fn section(_opts: &Options) -> Result<Section, Box<dyn Error>> {
         {
             write!(
                 html,
-                "<tr><td>{m}</td><td>{}</td><td>{:.4}</td><td>{:.2e}</td><td>{:.2e}</td><td>{:.4}</td><td>{:.1}</td><td>{:.4}</td><td>{}</td></tr>",
+                "<tr><td>{m}</td><td>{}</td><td>{:.4}</td><td>{:.2e}</td><td>{:.2e}</td><td>{:.2e}</td><td>{:.4}</td><td>{:.1}</td><td>{:.4}</td><td>{}</td></tr>",
                 p.setting,
                 p.seconds,
                 p.metrics.mean_abs_over_max,
                 p.metrics.rel_l2,
+                p.metrics.rel_l2_noise_corrected,
                 p.metrics.rmse,
                 p.metrics.psnr_db,
                 p.metrics.ssim,
@@ -458,12 +535,12 @@ pub fn section(_opts: &Options) -> Result<Section, Box<dyn Error>> {
             "bounces": r.bounces,
             "width": r.width,
             "height": r.height,
-            "reference_spp": REFERENCE_SPP,
+            "reference_spp": reference_spp(r.name),
             "reference_seconds": r.reference_seconds,
             "path": r.path.iter().map(point_json).collect::<Vec<_>>(),
-            "curve": r.curve.iter().map(point_json).collect::<Vec<_>>(),
+            "curve": r.curve.iter().map(|p| method_point_json(&r.path, p)).collect::<Vec<_>>(),
             "default": d.setting,
-            "variants": r.variants.iter().map(point_json).collect::<Vec<_>>(),
+            "variants": r.variants.iter().map(|p| method_point_json(&r.path, p)).collect::<Vec<_>>(),
             "equal_error_cost_ratio": r.equal_error_ratio,
         }));
     }

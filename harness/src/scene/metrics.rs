@@ -15,6 +15,11 @@
 //!   `[0, 1]` (`srgb(v·2^exposure)`), PSNR `= −20·log10(rmse)`;
 //! - `ssim`: over the whole 8-bit tone-mapped image, by `image-compare`'s SSIM (8 × 8
 //!   windows, the smallest of the three channels' means);
+//! - `rel_l2_noise_corrected`: `rel_l2` with the reference's noise taken out. For an image
+//!   independent of the reference's samples, `E[(m − r)²] = (m − t)² + σ²` and
+//!   `E[r²] = t² + σ²` (`t` the noise-free value, `σ` the reference's standard error), so
+//!   `√((Σ(m − r)² − Σσ²)⁺ / (Σr² − Σσ²))` estimates the error against the noise-free
+//!   image; without a standard error it equals `rel_l2`;
 //! - `reference_noise_over_max`: the mean over shaded pixels of the reference's standard
 //!   error over `max_radiance`, so an error can be judged against the reference's noise.
 
@@ -58,6 +63,9 @@ pub struct Metrics {
     pub max_abs_over_max: f64,
     /// Relative L2 over shaded pixels.
     pub rel_l2: f64,
+    /// Relative L2 over shaded pixels with the reference's variance subtracted (module
+    /// docs).
+    pub rel_l2_noise_corrected: f64,
     /// RMSE of the tone-mapped images, whole image.
     pub rmse: f64,
     /// PSNR in dB of the tone-mapped images.
@@ -112,7 +120,7 @@ pub fn compare(
         1.0
     };
     let (mut sum_abs, mut max_abs, mut n_shaded) = (0.0, 0.0f64, 0usize);
-    let (mut d2, mut r2, mut noise) = (0.0, 0.0, 0.0);
+    let (mut d2, mut r2, mut noise, mut var) = (0.0, 0.0, 0.0, 0.0);
     let (mut sil_abs, mut n_sil) = (0.0, 0usize);
     for (k, c) in class.iter().enumerate() {
         let (a, b) = (img.data[k], reference.data[k]);
@@ -128,6 +136,7 @@ pub fn compare(
                 }
                 if let Some(se) = stderr {
                     noise += se.data[k].iter().sum::<f64>() / 3.0;
+                    var += se.data[k].iter().map(|e| e * e).sum::<f64>();
                 }
             }
             None => {
@@ -162,6 +171,11 @@ pub fn compare(
         mean_abs_over_max: per(sum_abs, n_shaded),
         max_abs_over_max: max_abs / scale,
         rel_l2: if r2 > 0.0 { (d2 / r2).sqrt() } else { 0.0 },
+        rel_l2_noise_corrected: if r2 - var > 0.0 {
+            ((d2 - var).max(0.0) / (r2 - var)).sqrt()
+        } else {
+            0.0
+        },
         rmse,
         psnr_db: if rmse > 0.0 {
             -20.0 * rmse.log10()

@@ -186,8 +186,7 @@ pub fn plan(scene: &Scene, o: &Options) -> Result<Plan, String> {
                 reason: format!(
                     "subdivision levels below a visibility texel: the coarsest whose visible \
                      solid angle is within {:.1e} relative (a tenth of the target error {})",
-                    DEPTH_BOUNDS[r.vis_depth as usize].1,
-                    o.target_error
+                    DEPTH_BOUNDS[r.vis_depth as usize].1, o.target_error
                 ),
             });
             if !scene.lights.is_empty() {
@@ -301,8 +300,15 @@ pub fn run(scene: &Scene, scene_name: &str, o: &Options, plan: &Plan) -> Result<
             )
         }
         Method::Rsl => {
-            let img = super::rsl::render(scene, &plan.rsl, &b)?;
-            (img, None, json!({ "rsls": plan.rsl.k }))
+            let t = Instant::now();
+            let built = super::rsl::build(scene, &plan.rsl)?;
+            let build_seconds = t.elapsed().as_secs_f64();
+            let img = super::rsl::render_built(scene, &built, &plan.rsl, &b);
+            (
+                img,
+                None,
+                json!({ "rsls": plan.rsl.k, "build_seconds": build_seconds }),
+            )
         }
         Method::Hvl => {
             let (img, count) = super::hvl::render(scene, &plan.hvl, &b);

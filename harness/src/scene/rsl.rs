@@ -186,12 +186,18 @@ pub fn shade_point(
     out
 }
 
-/// One pixel-centre sample per pixel ([`super::render_centres`]).
+/// One pixel-centre sample per pixel ([`super::render_centres`]), building first.
 pub fn render(scene: &Scene, o: &Options, bar: &ProgressBar) -> Result<Image, String> {
     let built = build(scene, o)?;
+    Ok(render_built(scene, &built, o, bar))
+}
+
+/// [`render`] with what [`build`] made: the per-frame work once the environment is
+/// decomposed and the BRDF tables fitted (the paper's precomputation).
+pub fn render_built(scene: &Scene, built: &Built, o: &Options, bar: &ProgressBar) -> Image {
     let new_cov = || vec![0.0f32; o.vis_side * o.vis_side];
     let (img, _) = render_centres(scene, bar, new_cov, |cov, p| {
-        shade_point(scene, &built, o, p, cov)
+        shade_point(scene, built, o, p, cov)
     });
-    Ok(img)
+    img
 }
