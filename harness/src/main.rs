@@ -65,7 +65,7 @@ enum Command {
     Render {
         /// Scene file, or builtin:lobes, builtin:cluster, builtin:environment, builtin:room.
         scene: String,
-        /// Method: path (the reference) or lobes.
+        /// Method: path (the reference), lobes, hvl or rsl.
         #[arg(long, default_value = "path")]
         method: String,
         /// Output directory.
@@ -93,6 +93,10 @@ enum Command {
         /// No progress bar.
         #[arg(long)]
         quiet: bool,
+        /// Shade with the scalar kernels (rsl shades eight points at a time with its SIMD
+        /// kernel otherwise; the other methods are scalar).
+        #[arg(long)]
+        scalar: bool,
     },
 }
 
@@ -149,6 +153,7 @@ fn main() -> ExitCode {
             width,
             seed,
             quiet,
+            scalar,
         } => {
             let o = scene::render::Options {
                 method: scene::render::Method::Path,
@@ -159,6 +164,7 @@ fn main() -> ExitCode {
                 exposure,
                 seed,
                 quiet,
+                scalar,
             };
             match render(&spec, width, &method, o) {
                 Ok(()) => ExitCode::SUCCESS,

@@ -468,6 +468,8 @@ fn rsl_method_against_the_path_tracer_on_a_small_environment_scene() {
     let m = small.errors(&img);
     eprintln!("rsl {m:?}");
     assert!(m.rel_l2 < 0.035, "{m:?}");
+    // Against the noise-free image (the 32768-sample reference gives 2.0 %).
+    assert!(m.rel_l2_noise_corrected < 0.025, "{m:?}");
     assert!(
         m.mean_abs_over_max < 0.012 + 4.0 * m.reference_noise_over_max,
         "{m:?}"
@@ -508,4 +510,32 @@ fn noise_corrected_rel_l2_removes_the_reference_noise() {
     assert_eq!(exact.rel_l2, exact.rel_l2_noise_corrected);
     assert!(noisy.rel_l2 > 2.0 * exact.rel_l2);
     assert!((noisy.rel_l2_noise_corrected / exact.rel_l2 - 1.0).abs() < 0.1);
+}
+
+/// The `rsl` method's SIMD path gives every pixel of the scalar path within the moments
+/// kernel's tolerance (relative to the pixel's largest channel), on the glossy and the
+/// diffuse objects of the `environment` scene, and the same pixels as the scalar path.
+#[test]
+fn rsl_simd_path_matches_the_scalar_path_pixel_by_pixel() {
+    use steradian_harness::scene::rsl;
+    use steradian_simd::rsl::shade::MOMENTS_REL_TOL;
+    let mut scene = Scene::load("builtin:environment").unwrap();
+    scene.camera = scene.camera.resized(40).unwrap();
+    let o = rsl::Options::default();
+    let built = rsl::build(&scene, &o).unwrap();
+    let hidden = ProgressBar::hidden();
+    let scalar = rsl::render_built(&scene, &built, &o, &hidden);
+    let simd = rsl::render_built_simd(&scene, &built, &o, &hidden).unwrap();
+    let mut lit = 0;
+    for (a, b) in scalar.data.iter().zip(&simd.data) {
+        let m = a.iter().cloned().fold(0.0, f64::max);
+        lit += (m > 0.0) as usize;
+        for c in 0..3 {
+            assert!(
+                (a[c] - b[c]).abs() <= MOMENTS_REL_TOL as f64 * m.max(1e-30),
+                "{a:?} vs {b:?}"
+            );
+        }
+    }
+    assert!(lit > 1000, "{lit}");
 }

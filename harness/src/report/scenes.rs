@@ -30,7 +30,7 @@ use super::plot::{Axis, Chart, Pt, Scale, Series};
 use super::section::Section;
 use crate::scene::image::Image;
 use crate::scene::metrics::{self, Metrics};
-use crate::scene::{Scene, hvl, lobes, path, rsl};
+use crate::scene::{Scene, Seen, hvl, lobes, path, rsl};
 
 /// Image width of the section's renders (the height follows each scene's aspect ratio).
 pub const WIDTH: u32 = 96;
@@ -82,6 +82,8 @@ struct SceneResult {
     curve: Vec<Point>,
     /// Single points: the method with one choice changed.
     variants: Vec<Point>,
+    /// Shading throughput on one core: (kernel, setting, seconds, surface points).
+    per_core: Vec<(&'static str, String, f64, usize)>,
     /// The path tracer's time at the default point's error over that point's time.
     equal_error_ratio: f64,
     files: Vec<(String, Vec<u8>)>,
@@ -138,7 +140,7 @@ fn cost_ratios(path: &[Point], p: &Point) -> (Option<f64>, Option<f64>) {
 }
 
 /// A method's render under one setting: the image and its kernel products per pixel.
-type Render<'a> = Box<dyn Fn() -> (Image, Option<f64>) + 'a>;
+type Render<'a> = Box<dyn Fn() -> (Image, Option<f64>) + Sync + 'a>;
 
 /// One setting to measure: its label, the render, and whether it is the default.
 struct Setting<'a> {
@@ -237,30 +239,34 @@ fn hvl_settings(scene: &Scene) -> (Vec<Setting<'_>>, Vec<Setting<'_>>) {
     (curve, variants)
 }
 
+/// The label suffix of a setting shaded by a SIMD kernel.
+const SIMD_LABEL: &str = ", SIMD kernel";
+
 fn rsl_settings(scene: &Scene) -> (Vec<Setting<'_>>, Vec<Setting<'_>>) {
     let d = rsl::Options::default();
-    let curve = RSL_KS
-        .iter()
-        .map(|&k| {
-            let o = rsl::Options { k, ..d };
-            let (built, build_seconds) = timed(|| rsl::build(scene, &o));
-            Setting {
-                label: format!("K = {k}"),
-                render: Box::new(move || {
-                    let img = match &built {
-                        Ok(b) => rsl::render_built(scene, b, &o, &ProgressBar::hidden()),
-                        Err(_) => {
-                            Image::new(scene.camera.width as usize, scene.camera.height as usize)
-                        }
-                    };
-                    (img, None)
-                }),
-                default: k == d.k,
-                build_seconds: Some(build_seconds),
-            }
-        })
-        .collect();
-    (curve, Vec::new())
+    let setting = |k: usize, simd: bool| {
+        let o = rsl::Options { k, ..d };
+        let (built, build_seconds) = timed(|| rsl::build(scene, &o));
+        let blank = || Image::new(scene.camera.width as usize, scene.camera.height as usize);
+        Setting {
+            label: format!("K = {k}{}", if simd { SIMD_LABEL } else { "" }),
+            render: Box::new(move || {
+                let hidden = ProgressBar::hidden();
+                let img = match &built {
+                    Ok(b) if simd => {
+                        rsl::render_built_simd(scene, b, &o, &hidden).unwrap_or_else(|_| blank())
+                    }
+                    Ok(b) => rsl::render_built(scene, b, &o, &hidden),
+                    Err(_) => blank(),
+                };
+                (img, None)
+            }),
+            default: k == d.k && !simd,
+            build_seconds: Some(build_seconds),
+        }
+    };
+    let curve = RSL_KS.iter().map(|&k| setting(k, false)).collect();
+    (curve, vec![setting(d.k, true)])
 }
 
 fn png(img: &Image) -> Result<Vec<u8>, String> {
@@ -343,6 +349,30 @@ fn measure_scene(
         .iter()
         .map(|st| measure(st).map(|(p, _)| p))
         .collect::<Result<Vec<_>, _>>()?;
+    // Throughput on one core: the default setting (scalar) and, for `rsl`, its SIMD
+    // variant, each the best of two renders in a one-thread pool.
+    let surface_points = (0..scene.camera.height)
+        .flat_map(|j| (0..scene.camera.width).map(move |i| (i, j)))
+        .filter(|&(i, j)| matches!(scene.see(&scene.camera.centre_ray(i, j)), Seen::Surface(_)))
+        .count();
+    let pool = rayon::ThreadPoolBuilder::new().num_threads(1).build()?;
+    let mut per_core = Vec::new();
+    for (kernel, st) in curve_settings
+        .iter()
+        .filter(|st| st.default)
+        .map(|st| ("scalar", st))
+        .chain(
+            variant_settings
+                .iter()
+                .filter(|st| st.label.ends_with(SIMD_LABEL))
+                .map(|st| ("simd", st)),
+        )
+    {
+        let s = (0..2)
+            .map(|_| timed(|| pool.install(|| (st.render)())).1)
+            .fold(f64::INFINITY, f64::min);
+        per_core.push((kernel, st.label.clone(), s, surface_points));
+    }
     bar.inc(1);
     let (dp, dimg) = default_img.ok_or("the default setting is on the curve")?;
     let equal_error_ratio = cost_ratios(&path_curve, &dp).0.unwrap_or(f64::NAN);
@@ -368,6 +398,7 @@ fn measure_scene(
         path: path_curve,
         curve,
         variants,
+        per_core,
         equal_error_ratio,
         files,
     })
@@ -489,6 +520,12 @@ pub fn section(_opts: &Options) -> Result<Section, Box<dyn Error>> {
             best(0),
             best(1)
         )?;
+        let per_core: Vec<String> = r
+            .per_core
+            .iter()
+            .map(|(k, st, s, n)| format!("{k} ({st}) {:.0} points/s", *n as f64 / s))
+            .collect();
+        writeln!(summary, "    one core: {}", per_core.join(", "))?;
         writeln!(
             html,
             "<h3>{} ({})</h3><p>{}×{}; reference {:.1} s. The path tracer needs {:.1}× the time of \
@@ -542,6 +579,13 @@ pub fn section(_opts: &Options) -> Result<Section, Box<dyn Error>> {
             "default": d.setting,
             "variants": r.variants.iter().map(|p| method_point_json(&r.path, p)).collect::<Vec<_>>(),
             "equal_error_cost_ratio": r.equal_error_ratio,
+            "per_core": r.per_core.iter().map(|(kernel, setting, seconds, points)| json!({
+                "kernel": kernel,
+                "setting": setting,
+                "seconds": seconds,
+                "shading_points": points,
+                "points_per_second": *points as f64 / seconds,
+            })).collect::<Vec<_>>(),
         }));
     }
     Ok(Section {

@@ -70,6 +70,8 @@ pub struct Options {
     pub seed: u64,
     /// Hide the progress bar.
     pub quiet: bool,
+    /// Shade with the scalar kernels (`rsl` uses its SIMD kernel otherwise).
+    pub scalar: bool,
 }
 
 impl Default for Options {
@@ -83,6 +85,7 @@ impl Default for Options {
             exposure: 0.0,
             seed: 1,
             quiet: false,
+            scalar: false,
         }
     }
 }
@@ -173,6 +176,16 @@ pub fn plan(scene: &Scene, o: &Options) -> Result<Plan, String> {
                     r.vis_side
                 )),
                 reason: "caps of the other spheres and the planes the point is not on".into(),
+            });
+            p.push(PlanItem {
+                item: "kernel".into(),
+                value: json!(if o.scalar { "scalar" } else { "simd" }),
+                reason: if o.scalar {
+                    "--scalar: the scalar moments kernel, one point at a time".into()
+                } else {
+                    "the SIMD moments kernel, eight points at a time (--scalar for the scalar one)"
+                        .into()
+                },
             });
             // The coarsest coverage whose visible solid angle is within a tenth of the
             // target (the asserted bounds of `DEPTH_BOUNDS`).
@@ -303,11 +316,19 @@ pub fn run(scene: &Scene, scene_name: &str, o: &Options, plan: &Plan) -> Result<
             let t = Instant::now();
             let built = super::rsl::build(scene, &plan.rsl)?;
             let build_seconds = t.elapsed().as_secs_f64();
-            let img = super::rsl::render_built(scene, &built, &plan.rsl, &b);
+            let img = if o.scalar {
+                super::rsl::render_built(scene, &built, &plan.rsl, &b)
+            } else {
+                super::rsl::render_built_simd(scene, &built, &plan.rsl, &b)?
+            };
             (
                 img,
                 None,
-                json!({ "rsls": plan.rsl.k, "build_seconds": build_seconds }),
+                json!({
+                    "rsls": plan.rsl.k,
+                    "build_seconds": build_seconds,
+                    "kernel": if o.scalar { "scalar" } else { "simd" },
+                }),
             )
         }
         Method::Hvl => {

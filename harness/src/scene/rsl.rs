@@ -30,7 +30,7 @@ use steradian_core::rsl::visibility::{Outside, coverage_into_depth, local_cap};
 
 use super::image::Image;
 use super::material::Material;
-use super::{Rgb, Scene, ShadingPoint, Shape, render_centres};
+use super::{Rgb, Scene, Seen, ShadingPoint, Shape, render_centres};
 use crate::env::Equirect;
 use crate::env::decompose::decompose;
 
@@ -118,27 +118,19 @@ pub fn build(scene: &Scene, o: &Options) -> Result<Built, String> {
     })
 }
 
-/// The reflected radiance at a surface point.
-pub fn shade_point(
+/// The visibility moment tables of a surface point (module docs), `None` where the point
+/// has no frame or its map cannot be built (it is then shaded black).
+pub fn point_moments(
     scene: &Scene,
-    b: &Built,
     o: &Options,
     p: &ShadingPoint,
     cov: &mut [f32],
-) -> Rgb {
-    let ShadingPoint {
-        object,
-        material: mi,
-        x,
-        n,
-        wo,
-    } = *p;
-    let Ok(frame) = Frame::from_normal(n.as_vec3()) else {
-        return [0.0; 3];
-    };
+) -> Option<(Frame, VisMoments)> {
+    let frame = Frame::from_normal(p.n.as_vec3()).ok()?;
+    let x = p.x;
     let mut caps = Vec::new();
     for (id, obj) in scene.objects.iter().enumerate() {
-        if id == object {
+        if id == p.object {
             continue;
         }
         match obj.shape {
@@ -159,31 +151,150 @@ pub fn shade_point(
             }
         }
     }
-    if coverage_into_depth(&caps, o.vis_side, Outside::Visible, o.vis_depth, cov).is_err() {
-        return [0.0; 3];
-    }
-    let Ok(moments) = VisMoments::build_coverage(o.vis_side, cov) else {
-        return [0.0; 3];
-    };
-    let wo = wo.as_vec3();
-    let mat = &scene.materials[mi];
-    let d = shade::shade_moments(&frame, wo, &b.lambert, &moments, &b.lights);
-    let mut out = [0.0; 3];
+    coverage_into_depth(&caps, o.vis_side, Outside::Visible, o.vis_depth, cov).ok()?;
+    let moments = VisMoments::build_coverage(o.vis_side, cov).ok()?;
+    Some((frame, moments))
+}
+
+/// The reflected radiance from the diffuse and specular integrals `d`, `s` (each
+/// [`shade::shade_moments`] with the Lambert and the material's Phong SAT).
+fn combine(mat: &Material, d: [f32; 3], s: Option<[f32; 3]>) -> Rgb {
     let diffuse = mat.diffuse();
-    for c in 0..3 {
-        out[c] = diffuse[c] * d[c] as f64;
-    }
-    if let Material::Phong {
-        specular, exponent, ..
-    } = mat
-        && let Some(sat) = b.phong.get(&exponent.to_bits())
-    {
-        let s = shade::shade_moments(&frame, wo, sat, &moments, &b.lights);
+    let mut out: Rgb = core::array::from_fn(|c| diffuse[c] * d[c] as f64);
+    if let (Material::Phong { specular, .. }, Some(s)) = (mat, s) {
         for c in 0..3 {
             out[c] += specular[c] * s[c] as f64;
         }
     }
     out
+}
+
+/// The Phong SAT of a material, if it has one.
+fn phong_sat<'a>(b: &'a Built, mat: &Material) -> Option<&'a BrdfSat> {
+    match mat {
+        Material::Phong { exponent, .. } => b.phong.get(&exponent.to_bits()),
+        _ => None,
+    }
+}
+
+/// The reflected radiance at a surface point.
+pub fn shade_point(
+    scene: &Scene,
+    b: &Built,
+    o: &Options,
+    p: &ShadingPoint,
+    cov: &mut [f32],
+) -> Rgb {
+    let Some((frame, moments)) = point_moments(scene, o, p, cov) else {
+        return [0.0; 3];
+    };
+    let wo = p.wo.as_vec3();
+    let mat = &scene.materials[p.material];
+    let d = shade::shade_moments(&frame, wo, &b.lambert, &moments, &b.lights);
+    let s = phong_sat(b, mat).map(|sat| shade::shade_moments(&frame, wo, sat, &moments, &b.lights));
+    combine(mat, d, s)
+}
+
+/// [`render_built`] through the SIMD moments kernel: per row, each surface point's moment
+/// tables as in [`shade_point`], then eight points at a time through
+/// [`steradian_simd::rsl::shade::shade_moments_batch`] with the Lambert SAT and with each
+/// Phong SAT its points need. Each pixel is within the kernel's
+/// [`steradian_simd::rsl::shade::MOMENTS_REL_TOL`] of [`render_built`] (relative to the
+/// pixel's largest channel; the harness test asserts it). `Err` for a BRDF SAT the SIMD
+/// kernel does not take (anisotropic).
+pub fn render_built_simd(
+    scene: &Scene,
+    built: &Built,
+    o: &Options,
+    bar: &ProgressBar,
+) -> Result<Image, String> {
+    use rayon::prelude::*;
+    use steradian_core::rsl::shade::gpu::iso_views;
+    use steradian_simd::rsl::shade::{IsoBrdfTables, MomentsInput, shade_moments_batch};
+
+    fn iso(sat: &BrdfSat) -> Result<Vec<steradian_core::rsl::sat::SatView<'_>>, String> {
+        iso_views(sat).ok_or_else(|| "the SIMD kernel takes isotropic BRDF SATs".to_string())
+    }
+    let lambert_views = iso(&built.lambert)?;
+    let phong_views = built
+        .phong
+        .iter()
+        .map(|(k, sat)| Ok((*k, (iso(sat)?, sat.s_max()))))
+        .collect::<Result<BTreeMap<_, _>, String>>()?;
+    let lambert = IsoBrdfTables {
+        tables: &lambert_views,
+        s_max: built.lambert.s_max(),
+    };
+    let cam = scene.camera;
+    let (w, h) = (cam.width as usize, cam.height as usize);
+    let rows: Vec<Result<Vec<Rgb>, String>> = (0..h)
+        .into_par_iter()
+        .map(|j| {
+            let mut cov = vec![0.0f32; o.vis_side * o.vis_side];
+            let mut row = vec![[0.0; 3]; w];
+            // (pixel, point, frame, tables) of the row's shaded points.
+            let mut pts = Vec::with_capacity(w);
+            for (i, px) in row.iter_mut().enumerate() {
+                match scene.see(&cam.centre_ray(i as u32, j as u32)) {
+                    Seen::Radiance(l) => *px = l,
+                    Seen::Surface(p) => {
+                        if let Some((frame, m)) = point_moments(scene, o, &p, &mut cov) {
+                            pts.push((i, p, frame, m));
+                        }
+                    }
+                }
+            }
+            let input = |sel: &[usize]| -> Vec<MomentsInput<'_>> {
+                sel.iter()
+                    .map(|&k| MomentsInput {
+                        frame: pts[k].2,
+                        wo: pts[k].1.wo.as_vec3(),
+                        vis: pts[k].3.view(),
+                    })
+                    .collect()
+            };
+            let all: Vec<usize> = (0..pts.len()).collect();
+            let mut d = vec![[0.0f32; 3]; pts.len()];
+            if !shade_moments_batch(&input(&all), &lambert, &built.lights, &mut d) {
+                return Err("visibility tables of different sizes".to_string());
+            }
+            let mut s: Vec<Option<[f32; 3]>> = vec![None; pts.len()];
+            for (key, (views, s_max)) in &phong_views {
+                let sel: Vec<usize> = all
+                    .iter()
+                    .copied()
+                    .filter(|&k| {
+                        matches!(scene.materials[pts[k].1.material],
+                            Material::Phong { exponent, .. } if exponent.to_bits() == *key)
+                    })
+                    .collect();
+                if sel.is_empty() {
+                    continue;
+                }
+                let tables = IsoBrdfTables {
+                    tables: views,
+                    s_max: *s_max,
+                };
+                let mut out = vec![[0.0f32; 3]; sel.len()];
+                if !shade_moments_batch(&input(&sel), &tables, &built.lights, &mut out) {
+                    return Err("visibility tables of different sizes".to_string());
+                }
+                for (k, v) in sel.into_iter().zip(out) {
+                    s[k] = Some(v);
+                }
+            }
+            for (k, (i, p, _, _)) in pts.iter().enumerate() {
+                row[*i] = combine(&scene.materials[p.material], d[k], s[k]);
+            }
+            bar.inc(1);
+            Ok(row)
+        })
+        .collect();
+    let mut img = Image::new(w, h);
+    for (j, row) in rows.into_iter().enumerate() {
+        img.data[j * w..(j + 1) * w].copy_from_slice(&row?);
+    }
+    Ok(img)
 }
 
 /// One pixel-centre sample per pixel ([`super::render_centres`]), building first.
