@@ -750,11 +750,9 @@ impl BrdfSat {
         let h = crate::rsl::sat::square_half_side(half_diagonal) * n.half_n;
         // [whole, right − left, top − bottom] of one table around `tc` (texel units).
         let parts = |k: usize| -> [f64; 3] {
-            let v = self.sats[k].view();
-            let b = |u0: f32, v0: f32, u1: f32, v1: f32| v.box_sum_f64(u0, v0, u1, v1);
-            let whole = b(tc.x - h, tc.y - h, tc.x + h, tc.y + h);
-            let right = b(tc.x, tc.y - h, tc.x + h, tc.y + h);
-            let top = b(tc.x - h, tc.y, tc.x + h, tc.y + h);
+            let [whole, right, top] = self.sats[k]
+                .view()
+                .box3_f64([tc.x - h, tc.x, tc.x + h], [tc.y - h, tc.y, tc.y + h]);
             [whole, 2.0 * right - whole, 2.0 * top - whole]
         };
         let lerp = |a: [f64; 3], b: [f64; 3], u: f64| -> [f64; 3] {

@@ -361,6 +361,75 @@ impl<'a> SatView<'a> {
         self.fractional_box(u0, v0, u1, v1)
     }
 
+    /// The three boxes `[whole, right, top]` = `[x0, x1] × [y0, y1]`, `[xc, x1] × [y0, y1]`,
+    /// `[x0, x1] × [yc, y1]` for `x0 ≤ xc ≤ x1`, `y0 ≤ yc ≤ y1` (texel units): each the same
+    /// bits as [`SatView::box_sum_f64`] on its box, with the corners the boxes share read
+    /// once (32 entries instead of 48, three corner positions per axis instead of six).
+    /// The BRDF gradient of [`crate::rsl::brdf_sat::BrdfSat::integral_gradient`] takes
+    /// these three. Any NaN gives NaN in all three.
+    #[inline]
+    pub fn box3_f64(&self, [x0, xc, x1]: [f32; 3], [y0, yc, y1]: [f32; 3]) -> [f64; 3] {
+        if [x0, xc, x1, y0, yc, y1].iter().any(|v| v.is_nan()) {
+            return [f64::NAN; 3];
+        }
+        // `axis` corner by corner: the boxes' corners are ordered, so each corner's index
+        // and fraction are what `axis` gives it within any of the boxes.
+        let corner = |x: f32, n: usize| -> (usize, f32) {
+            let (i, a, _, _) = axis(x, x, n);
+            (i, a)
+        };
+        let (w, h) = (self.width, self.height);
+        let ((i0, a0), (ic, ac), (i1, a1)) = (corner(x0, w), corner(xc, w), corner(x1, w));
+        let ((j0, b0), (jc, bc), (j1, b1)) = (corner(y0, h), corner(yc, h), corner(y1, h));
+        let w1 = w + 1;
+        let (i0, ic, i1) = (i0.min(w - 1), ic.min(w - 1), i1.min(w - 1));
+        // Per row: [S(I0), S(I0+1), S(Ic), S(Ic+1), S(I1), S(I1+1)].
+        let row = |l: usize| -> [i64; 6] {
+            match row_range(l, w1).and_then(|range| self.sums.get(range)) {
+                Some(r) => [r[i0], r[i0 + 1], r[ic], r[ic + 1], r[i1], r[i1 + 1]],
+                None => [0; 6],
+            }
+        };
+        let next = |l: usize, b: f32, r: [i64; 6]| {
+            if b != 0.0 {
+                row(l.saturating_add(1))
+            } else {
+                r
+            }
+        };
+        let (r0, r1, rc) = (row(j0), row(j1), row(jc));
+        let (r0p, r1p, rcp) = (next(j0, b0, r0), next(j1, b1, r1), next(jc, bc, rc));
+        // `integer_terms`' [P, E1, E0] between rows l and m, on the columns (lo, hi).
+        let d = |l: [i64; 6], m: [i64; 6], lo: usize, hi: usize| -> [i64; 3] {
+            let p = m[hi]
+                .wrapping_sub(m[lo])
+                .wrapping_sub(l[hi].wrapping_sub(l[lo]));
+            let e1 = m[hi + 1]
+                .wrapping_sub(m[hi])
+                .wrapping_sub(l[hi + 1].wrapping_sub(l[hi]));
+            let e0 = m[lo + 1]
+                .wrapping_sub(m[lo])
+                .wrapping_sub(l[lo + 1].wrapping_sub(l[lo]));
+            [p, e1, e0]
+        };
+        let bx = |(l, lp, bl): ([i64; 6], [i64; 6], f32), lo: usize, a_lo: f32, hi: usize| {
+            BoxTerms {
+                k: [d(l, r1, lo, hi), d(r1, r1p, lo, hi), d(l, lp, lo, hi)],
+                a0: a_lo,
+                a1,
+                b0: bl,
+                b1,
+            }
+            .combine()
+                * self.scale
+        };
+        [
+            bx((r0, r0p, b0), 0, a0, 4),
+            bx((r0, r0p, b0), 2, ac, 4),
+            bx((rc, rcp, bc), 0, a0, 4),
+        ]
+    }
+
     /// The rest of [`SatView::box_sum_f64`]: fractional (or NaN) corners, the nine-term
     /// combination. Kept out of line (it repeats the two `axis` calls rather than take
     /// their results through memory) so that the integer path inlines into callers' loops.
@@ -430,6 +499,28 @@ impl<'a> SatView<'a> {
                 .wrapping_sub(r0[i1].wrapping_sub(r0[i0])),
             _ => 0,
         }
+    }
+
+    /// The entries `S(cols[c], rows[r])` in quanta, `out[r][c]` (columns clamped to the
+    /// width; a row past the table reads as zeros): the corners that several
+    /// [`SatView::integer_box`] queries on one grid of knots share, each read once. A box
+    /// between knots is then `out[r1][c1] − out[r1][c0] − (out[r0][c1] − out[r0][c0])`
+    /// (wrapping), the same bits as `integer_box`.
+    #[inline(always)]
+    pub fn corners<const C: usize, const R: usize>(
+        &self,
+        cols: [usize; C],
+        rows: [usize; R],
+    ) -> [[i64; C]; R] {
+        let w = self.width;
+        let w1 = w + 1;
+        let cols = cols.map(|c| c.min(w));
+        rows.map(
+            |l| match row_range(l, w1).and_then(|range| self.sums.get(range)) {
+                Some(r) => cols.map(|c| r[c]),
+                None => [0; C],
+            },
+        )
     }
 
     /// The integral over the axis-aligned square with centre `c` and half-diagonal `r`
@@ -774,6 +865,53 @@ mod tests {
                 "{got} {want}"
             );
         }
+    }
+
+    /// `box3_f64` is three `box_sum_f64` calls bit for bit: fractional and integer
+    /// corners, boxes reaching past the table, empty boxes, the last row and column, NaN.
+    #[test]
+    fn box3_is_three_box_queries_bit_for_bit() {
+        let (w, h) = (7, 5);
+        let t: Vec<f32> = (0..w * h).map(|k| (k as f32 * 0.61).cos() + 1.1).collect();
+        let sat = Sat::build(w, h, &t).unwrap();
+        let v = sat.view();
+        let mut seed = 0x9e37_79b9_7f4a_7c15u64;
+        let mut r = |lo: f32, hi: f32| {
+            seed ^= seed << 13;
+            seed ^= seed >> 7;
+            seed ^= seed << 17;
+            let u = (seed >> 40) as f32 / (1u64 << 24) as f32;
+            // A quarter of the draws land on integers.
+            let x = lo + (hi - lo) * u;
+            if seed & 3 == 0 { math::floorf(x) } else { x }
+        };
+        let mut cases: Vec<([f32; 2], f32)> = (0..4000)
+            .map(|_| ([r(-2.0, 9.0), r(-2.0, 7.0)], r(0.0, 4.0)))
+            .collect();
+        cases.extend([
+            ([3.5, 2.5], 0.0),
+            ([0.0, 0.0], 7.0),
+            ([7.0, 5.0], 0.5),
+            ([6.5, 4.5], 0.5),
+            ([3.0, 2.0], 1.0),
+        ]);
+        for ([cx, cy], hs) in cases {
+            let got = v.box3_f64([cx - hs, cx, cx + hs], [cy - hs, cy, cy + hs]);
+            let want = [
+                v.box_sum_f64(cx - hs, cy - hs, cx + hs, cy + hs),
+                v.box_sum_f64(cx, cy - hs, cx + hs, cy + hs),
+                v.box_sum_f64(cx - hs, cy, cx + hs, cy + hs),
+            ];
+            for k in 0..3 {
+                assert_eq!(
+                    got[k].to_bits(),
+                    want[k].to_bits(),
+                    "{cx} {cy} {hs} box {k}"
+                );
+            }
+        }
+        let nan = v.box3_f64([0.0, f32::NAN, 1.0], [0.0, 0.5, 1.0]);
+        assert!(nan.iter().all(|x| x.is_nan()));
     }
 
     #[test]

@@ -237,13 +237,31 @@ impl<'a> VisMomentsView<'a> {
         let [v, xv, yv] = self.tables();
         let (kx, ky) = (axis_knots(a0, a1, self.n), axis_knots(b0, b1, self.n));
         let (x, y) = (kx.knots, ky.knots);
-        let b = |t: &SatView<'_>, q: f64, i: usize, j: usize| {
-            t.integer_box(x[i], x[i + 1], y[j], y[j + 1]) as f64 * q
+        // The nine `V` blocks share a 4 × 4 grid of corners, the three `u·V` run boxes a
+        // 2 × 4 one and the three `v·V` run boxes a 4 × 2 one: 32 reads instead of 60,
+        // the same exact integer boxes as `integer_box` on each block.
+        let bx4 = |g: &[[i64; 4]; 4], i: usize, j: usize| {
+            g[j + 1][i + 1]
+                .wrapping_sub(g[j + 1][i])
+                .wrapping_sub(g[j][i + 1].wrapping_sub(g[j][i]))
         };
+        let gv = v.corners(x, y);
         let bv: [[f64; 3]; 3] =
-            core::array::from_fn(|i| core::array::from_fn(|j| b(&v, v.quantum(), i, j)));
-        let bx: [f64; 3] = core::array::from_fn(|j| b(&xv, xv.quantum(), 1, j));
-        let by: [f64; 3] = core::array::from_fn(|i| b(&yv, yv.quantum(), i, 1));
+            core::array::from_fn(|i| core::array::from_fn(|j| bx4(&gv, i, j) as f64 * v.quantum()));
+        let gx = xv.corners([x[1], x[2]], y);
+        let bx: [f64; 3] = core::array::from_fn(|j| {
+            gx[j + 1][1]
+                .wrapping_sub(gx[j + 1][0])
+                .wrapping_sub(gx[j][1].wrapping_sub(gx[j][0])) as f64
+                * xv.quantum()
+        });
+        let gy = yv.corners(x, [y[1], y[2]]);
+        let by: [f64; 3] = core::array::from_fn(|i| {
+            gy[1][i + 1]
+                .wrapping_sub(gy[1][i])
+                .wrapping_sub(gy[0][i + 1].wrapping_sub(gy[0][i])) as f64
+                * yv.quantum()
+        });
         combine_blocks(&kx, &ky, &bv, &bx, &by, cu - hn, cv - hn, cu, cv)
     }
 }
