@@ -69,6 +69,18 @@ pub enum MaterialFile {
         /// Exponent `n`, `0 ..= 1e5`.
         exponent: Exponent,
     },
+    /// GGX microfacet: `diffuse/π + specular·D·G₂·F/(4 cos θi cos θo)` with the GGX `D` of
+    /// roughness `α`, separable Smith `G₂` and Schlick's `F` from `f0` (core's `Ggx`).
+    Ggx {
+        /// RGB diffuse albedo.
+        diffuse: Albedo,
+        /// RGB tint of the specular term.
+        specular: Albedo,
+        /// Reflectance at normal incidence, `[0, 1]`.
+        f0: UnitInterval,
+        /// GGX `α` (perceptual roughness squared), `[1e-3, 1]`.
+        roughness: Roughness,
+    },
     /// Lafortune: `diffuse/π + Σ ρ_i·max(ωi·M_i·ωo, 0)^{e_i}` in the shading frame.
     Lafortune {
         /// RGB diffuse albedo.
@@ -226,6 +238,18 @@ checked!(
     FovDegrees(f64),
     |v| *v > 0.0 && *v < 180.0,
     "must be in (0, 180) degrees"
+);
+checked!(
+    /// A number in `[0, 1]`.
+    UnitInterval(f64),
+    |v| (0.0..=1.0).contains(v),
+    "must be in [0, 1]"
+);
+checked!(
+    /// A GGX roughness `α` in `[1e-3, 1]` (the range of core's `Ggx`).
+    Roughness(f64),
+    |v| (1e-3..=1.0).contains(v),
+    "must be in [0.001, 1]"
 );
 checked!(
     /// An exponent in `[0, 1e5]`.

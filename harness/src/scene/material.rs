@@ -11,7 +11,10 @@
 //! ∝ its luminance times its directional albedo bound `2π·ρ_k/(e_k + 1)`; diffuse
 //! directions are cosine distributed (pdf `cos θ/π`), lobe directions `cos^e` about the
 //! axis (pdf `(e+1)/(2π)·max(a·ωi, 0)^e`). [`Material::pdf`] is the mixture's density,
-//! which MIS needs.
+//! which MIS needs. A GGX material adds its microfacet term (core's `Ggx` in `f64`, tinted
+//! by `specular`), picked ∝ the tint's luminance (its albedo bound), with `ωi` the
+//! reflection of `ωo` about a normal drawn from `D(h)·cos θh` (pdf
+//! `D(h)·cos θh/(4|ωo·h|)`).
 
 use std::f64::consts::{PI, TAU};
 
@@ -49,6 +52,18 @@ pub enum Material {
         specular: Rgb,
         /// Exponent.
         exponent: f64,
+    },
+    /// GGX microfacet (core's `Ggx` with an RGB tint): `diffuse/π +
+    /// specular·D(h)·G₁(ωi)G₁(ωo)·F(ωi·h)/(4 cos θi cos θo)`.
+    Ggx {
+        /// RGB diffuse albedo.
+        diffuse: Rgb,
+        /// RGB tint of the specular term.
+        specular: Rgb,
+        /// Schlick's reflectance at normal incidence.
+        f0: f64,
+        /// GGX `α`.
+        alpha: f64,
     },
     /// Lafortune with isotropic lobes.
     Lafortune {
@@ -133,6 +148,27 @@ impl Material {
                     exponent: exponent.0,
                 }
             }
+            MaterialFile::Ggx {
+                diffuse,
+                specular,
+                f0,
+                roughness,
+            } => {
+                for c in 0..3 {
+                    if diffuse.0[c] + specular.0[c] > 1.0 {
+                        return Err(format!(
+                            "ggx: diffuse + specular must be ≤ 1 per channel (channel {c}: {})",
+                            diffuse.0[c] + specular.0[c]
+                        ));
+                    }
+                }
+                Material::Ggx {
+                    diffuse: diffuse.0,
+                    specular: specular.0,
+                    f0: f0.0,
+                    alpha: roughness.0,
+                }
+            }
             MaterialFile::Lafortune { diffuse, lobes } => {
                 if lobes.is_empty() || lobes.len() > 4 {
                     return Err(format!(
@@ -167,7 +203,9 @@ impl Material {
     pub fn diffuse(&self) -> Rgb {
         match self {
             Material::Lambert { albedo } => *albedo,
-            Material::Phong { diffuse, .. } | Material::Lafortune { diffuse, .. } => *diffuse,
+            Material::Phong { diffuse, .. }
+            | Material::Lafortune { diffuse, .. }
+            | Material::Ggx { diffuse, .. } => *diffuse,
         }
     }
 
@@ -176,7 +214,7 @@ impl Material {
     pub fn lobes(&self, n: DVec3, wo: DVec3) -> ViewLobes {
         let mut out = ViewLobes::default();
         match self {
-            Material::Lambert { .. } => {}
+            Material::Lambert { .. } | Material::Ggx { .. } => {}
             Material::Phong {
                 specular, exponent, ..
             } => {
@@ -212,6 +250,18 @@ impl Material {
             return [0.0; 3];
         }
         let mut f = self.diffuse().map(|d| d / PI);
+        if let Material::Ggx {
+            specular,
+            f0,
+            alpha,
+            ..
+        } = self
+        {
+            let s = ggx_specular(n, wo, wi, *f0, *alpha);
+            for (fc, k) in f.iter_mut().zip(specular) {
+                *fc += k * s;
+            }
+        }
         for l in self.lobes(n, wo).iter() {
             let c = l.axis.dot(wi);
             if c > 0.0 {
@@ -235,12 +285,21 @@ impl Material {
             *wk = lum(l.scale) * TAU / (l.exponent + 1.0);
         }
         let d = lum(self.diffuse());
-        let total = d + w.iter().sum::<f64>();
+        // GGX: its specular albedo is at most the tint's (F ≤ 1, G₂ ≤ 1).
+        let ggx = match self {
+            Material::Ggx {
+                specular, alpha, ..
+            } => Some((lum(*specular), *alpha)),
+            _ => None,
+        };
+        let total = d + w.iter().sum::<f64>() + ggx.map_or(0.0, |g| g.0);
         (total > 0.0 && total.is_finite()).then_some(Mixture {
             n,
+            wo,
             lobes,
             d,
             w,
+            ggx,
             total,
         })
     }
@@ -250,8 +309,11 @@ impl Material {
     pub fn sample(&self, n: DVec3, wo: DVec3, u: [f64; 3]) -> Option<(DVec3, f64)> {
         let m = self.mixture(n, wo)?;
         let mut pick = u[0] * m.total;
-        let wi = if pick < m.d || m.lobes.is_empty() {
+        let wi = if pick < m.d || (m.lobes.is_empty() && m.ggx.is_none()) {
             sample_power_cosine(n, 1.0, u[1], u[2])
+        } else if let Some((_, alpha)) = m.ggx {
+            let h = sample_ggx_normal(n, alpha, u[1], u[2]);
+            reflect(wo, h)
         } else {
             pick -= m.d;
             let mut k = m.lobes.len() - 1;
@@ -300,12 +362,15 @@ impl std::ops::Deref for ViewLobes {
     }
 }
 
-/// The sampling mixture of one view: diffuse weight `d`, lobe weights `w`.
+/// The sampling mixture of one view: diffuse weight `d`, lobe weights `w`, and the GGX
+/// weight and `α` of a GGX material.
 struct Mixture {
     n: DVec3,
+    wo: DVec3,
     lobes: ViewLobes,
     d: f64,
     w: [f64; MAX_LOBES],
+    ggx: Option<(f64, f64)>,
     total: f64,
 }
 
@@ -315,8 +380,67 @@ impl Mixture {
         for (l, wk) in self.lobes.iter().zip(&self.w) {
             p += wk / self.total * power_cosine_pdf(l.axis, l.exponent, wi);
         }
+        if let Some((wg, alpha)) = self.ggx {
+            p += wg / self.total * ggx_reflection_pdf(self.n, self.wo, wi, alpha);
+        }
         p
     }
+}
+
+/// The GGX normal distribution `D(h) = α²/(π((n·h)²(α² − 1) + 1)²)` (Walter et al. 2007,
+/// eq. 33), 0 for `n·h ≤ 0`.
+fn ggx_d(c: f64, alpha: f64) -> f64 {
+    if c <= 0.0 {
+        return 0.0;
+    }
+    let a2 = alpha * alpha;
+    let t = c * c * (a2 - 1.0) + 1.0;
+    a2 / (PI * t * t)
+}
+
+/// `D·G₁(ωi)G₁(ωo)·F/(4 cos θi cos θo)` with `G₁(c) = 2c/(c + √(α² + (1 − α²)c²))` and
+/// Schlick's `F = f0 + (1 − f0)(1 − ωi·h)⁵`, so the fraction is
+/// `D·F/((ci + si)(co + so))`, `s = √(α² + (1 − α²)c²)`: core's `Ggx`, in `f64`.
+fn ggx_specular(n: DVec3, wo: DVec3, wi: DVec3, f0: f64, alpha: f64) -> f64 {
+    let (ci, co) = (n.dot(wi), n.dot(wo));
+    if ci <= 0.0 || co <= 0.0 {
+        return 0.0;
+    }
+    let h = (wi + wo).normalize();
+    let a2 = alpha * alpha;
+    let si = (a2 + (1.0 - a2) * ci * ci).sqrt();
+    let so = (a2 + (1.0 - a2) * co * co).sqrt();
+    let m = 1.0 - wi.dot(h).clamp(0.0, 1.0);
+    let f = f0 + (1.0 - f0) * m.powi(5);
+    ggx_d(n.dot(h), alpha) * f / ((ci + si) * (co + so))
+}
+
+/// A microfacet normal with density `D(h)·(n·h)`: `tan²θ = α²u/(1 − u)` (inverting the
+/// GGX `D·cos` marginal), `φ = 2πu₂`.
+fn sample_ggx_normal(n: DVec3, alpha: f64, u1: f64, u2: f64) -> DVec3 {
+    let t2 = alpha * alpha * u1 / (1.0 - u1).max(1e-300);
+    let cos_t = 1.0 / (1.0 + t2).sqrt();
+    let sin_t = (1.0 - cos_t * cos_t).max(0.0).sqrt();
+    let (t, b) = basis(n);
+    let phi = TAU * u2;
+    (sin_t * phi.cos() * t + sin_t * phi.sin() * b + cos_t * n).normalize()
+}
+
+/// The density of `ωi = reflect(ωo, h)` with `h` from [`sample_ggx_normal`]:
+/// `D(h)(n·h)/(4|ωo·h|)` (the Jacobian of the reflection, Walter et al. eq. 14).
+fn ggx_reflection_pdf(n: DVec3, wo: DVec3, wi: DVec3, alpha: f64) -> f64 {
+    let h = wi + wo;
+    let len = h.length();
+    if len == 0.0 {
+        return 0.0;
+    }
+    let h = h / len;
+    let c = n.dot(h);
+    let oh = wo.dot(h).abs();
+    if c <= 0.0 || oh == 0.0 {
+        return 0.0;
+    }
+    ggx_d(c, alpha) * c / (4.0 * oh)
 }
 
 #[cfg(test)]
@@ -342,6 +466,18 @@ mod tests {
                     exponent: 20.0,
                     rho: [0.5, 0.4, 0.3],
                 }],
+            },
+            Material::Ggx {
+                diffuse: [0.3, 0.2, 0.1],
+                specular: [0.6, 0.6, 0.6],
+                f0: 0.04,
+                alpha: 0.2,
+            },
+            Material::Ggx {
+                diffuse: [0.0; 3],
+                specular: [1.0; 3],
+                f0: 0.9,
+                alpha: 0.05,
             },
         ]
     }
@@ -386,6 +522,39 @@ mod tests {
                 (mean - q).abs() < 4.0 * se + 1e-4 * q,
                 "{m:?}: sampled {mean} ± {se}, quadrature {q}"
             );
+        }
+    }
+
+    /// The GGX material is core's `Ggx` (in `f64`, with an RGB tint): the same value at
+    /// random directions, to `f32` precision (1e-4 relative: core's `f32` `D` loses a few
+    /// bits at `α = 1e-3` where the half vector is nearly tangent).
+    #[test]
+    fn ggx_is_cores_ggx() {
+        use steradian_core::lobe::brdf::{Brdf, Ggx};
+        let mut rng = Rng::new(3);
+        let n = DVec3::Z;
+        for &(f0, alpha) in &[(0.04, 0.2), (0.9, 0.05), (0.5, 1.0), (0.0, 0.001)] {
+            let m = Material::Ggx {
+                diffuse: [0.0; 3],
+                specular: [1.0; 3],
+                f0,
+                alpha,
+            };
+            let g = Ggx::new(0.0, f0 as f32, alpha as f32).unwrap();
+            for _ in 0..2000 {
+                let wi = DVec3::from(rng.sphere());
+                let wo = DVec3::from(rng.sphere());
+                let (wi, wo) = (
+                    DVec3::new(wi.x, wi.y, wi.z.abs()),
+                    DVec3::new(wo.x, wo.y, wo.z.abs()),
+                );
+                let ours = m.eval(n, wo, wi)[0] * wi.z;
+                let core = g.eval(wi.as_vec3(), wo.as_vec3()) as f64;
+                assert!(
+                    (ours - core).abs() <= 1e-4 * ours.abs().max(1e-3),
+                    "f0 {f0} α {alpha}: {ours} vs {core} at {wi} {wo}"
+                );
+            }
         }
     }
 

@@ -221,6 +221,17 @@ pub fn plan(scene: &Scene, o: &Options) -> Result<Plan, String> {
             if scene.lights.is_empty() {
                 return Err("method lobes needs at least one spherical light".into());
             }
+            if let Some(k) = scene
+                .materials
+                .iter()
+                .position(|m| matches!(m, super::material::Material::Ggx { .. }))
+            {
+                return Err(format!(
+                    "material {:?} is GGX, which has no cosine-lobe form: methods lobes and hvl \
+                     do not carry it (path and rsl do)",
+                    scene.material_names[k]
+                ));
+            }
             lo.threshold = (o.target_error / 10.0) as f32;
             p.push(PlanItem {
                 item: "threshold".into(),

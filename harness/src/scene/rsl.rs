@@ -7,7 +7,8 @@
 //!   ([`crate::env::decompose`]).
 //! - BRDF SATs are fitted for what the scene's materials need: one for the diffuse part
 //!   (Lambert, albedo 1, times each material's diffuse RGB) and one per distinct Phong
-//!   exponent for the specular part (modified Phong with `k_s = 1`, times the specular RGB).
+//!   exponent or GGX `(f0, α)` for the specular part (modified Phong with `k_s = 1`, or
+//!   core's `Ggx` with `k_d = 0`, times the specular RGB).
 //!   Lafortune lobes are not carried by this method (their diffuse part is).
 //! - Visibility at a point is the coverage map of the caps of every other sphere, and of
 //!   every plane the point is not on (a plane seen from a point off it is exactly the
@@ -21,7 +22,7 @@ use std::f32::consts::FRAC_PI_2;
 
 use indicatif::ProgressBar;
 use steradian_core::frame::Frame;
-use steradian_core::lobe::brdf::{Lambert, Phong};
+use steradian_core::lobe::brdf::{Ggx, Lambert, Phong};
 use steradian_core::lobe::cap::SphericalCap;
 use steradian_core::rsl::brdf_sat::BrdfSat;
 use steradian_core::rsl::shade::{self, ShadeLight};
@@ -68,8 +69,8 @@ pub struct Built {
     pub lights: Vec<ShadeLight>,
     /// The diffuse SAT.
     pub lambert: BrdfSat,
-    /// The specular SATs by exponent (as bits).
-    pub phong: BTreeMap<u64, BrdfSat>,
+    /// The specular SATs by [`SpecKey`].
+    pub specular: BTreeMap<SpecKey, BrdfSat>,
 }
 
 /// Decomposes the environment and fits the SATs the materials need.
@@ -101,20 +102,28 @@ pub fn build(scene: &Scene, o: &Options) -> Result<Built, String> {
         &refs,
         o.sat_target,
     );
-    let mut phong = BTreeMap::new();
+    let mut specular = BTreeMap::new();
     for m in &scene.materials {
-        if let Material::Phong { exponent, .. } = m {
-            let key = exponent.to_bits();
-            if let std::collections::btree_map::Entry::Vacant(e) = phong.entry(key) {
-                let b = Phong::new(0.0, 1.0, *exponent as f32).map_err(|e| e.to_string())?;
-                e.insert(crate::shade::fit_sat(&b, &refs, o.sat_target));
-            }
+        let Some(key) = spec_key(m) else { continue };
+        if let std::collections::btree_map::Entry::Vacant(e) = specular.entry(key) {
+            let sat = match *m {
+                Material::Phong { exponent, .. } => {
+                    let b = Phong::new(0.0, 1.0, exponent as f32).map_err(|e| e.to_string())?;
+                    crate::shade::fit_sat(&b, &refs, o.sat_target)
+                }
+                Material::Ggx { f0, alpha, .. } => {
+                    let b = Ggx::new(0.0, f0 as f32, alpha as f32).map_err(|e| e.to_string())?;
+                    crate::shade::fit_sat(&b, &refs, o.sat_target)
+                }
+                _ => continue,
+            };
+            e.insert(sat);
         }
     }
     Ok(Built {
         lights,
         lambert,
-        phong,
+        specular,
     })
 }
 
@@ -161,7 +170,7 @@ pub fn point_moments(
 fn combine(mat: &Material, d: [f32; 3], s: Option<[f32; 3]>) -> Rgb {
     let diffuse = mat.diffuse();
     let mut out: Rgb = core::array::from_fn(|c| diffuse[c] * d[c] as f64);
-    if let (Material::Phong { specular, .. }, Some(s)) = (mat, s) {
+    if let (Material::Phong { specular, .. } | Material::Ggx { specular, .. }, Some(s)) = (mat, s) {
         for c in 0..3 {
             out[c] += specular[c] * s[c] as f64;
         }
@@ -169,12 +178,22 @@ fn combine(mat: &Material, d: [f32; 3], s: Option<[f32; 3]>) -> Rgb {
     out
 }
 
-/// The Phong SAT of a material, if it has one.
-fn phong_sat<'a>(b: &'a Built, mat: &Material) -> Option<&'a BrdfSat> {
-    match mat {
-        Material::Phong { exponent, .. } => b.phong.get(&exponent.to_bits()),
+/// Which specular SAT a material needs: `(0, exponent bits, 0)` for modified Phong,
+/// `(1, f0 bits, α bits)` for GGX, `None` for the others.
+pub type SpecKey = (u8, u64, u64);
+
+/// The [`SpecKey`] of a material.
+pub fn spec_key(mat: &Material) -> Option<SpecKey> {
+    match *mat {
+        Material::Phong { exponent, .. } => Some((0, exponent.to_bits(), 0)),
+        Material::Ggx { f0, alpha, .. } => Some((1, f0.to_bits(), alpha.to_bits())),
         _ => None,
     }
+}
+
+/// The specular SAT of a material, if it has one.
+fn specular_sat<'a>(b: &'a Built, mat: &Material) -> Option<&'a BrdfSat> {
+    b.specular.get(&spec_key(mat)?)
 }
 
 /// The reflected radiance at a surface point.
@@ -191,7 +210,8 @@ pub fn shade_point(
     let wo = p.wo.as_vec3();
     let mat = &scene.materials[p.material];
     let d = shade::shade_moments(&frame, wo, &b.lambert, &moments, &b.lights);
-    let s = phong_sat(b, mat).map(|sat| shade::shade_moments(&frame, wo, sat, &moments, &b.lights));
+    let s =
+        specular_sat(b, mat).map(|sat| shade::shade_moments(&frame, wo, sat, &moments, &b.lights));
     combine(mat, d, s)
 }
 
@@ -216,8 +236,8 @@ pub fn render_built_simd(
         iso_views(sat).ok_or_else(|| "the SIMD kernel takes isotropic BRDF SATs".to_string())
     }
     let lambert_views = iso(&built.lambert)?;
-    let phong_views = built
-        .phong
+    let specular_views = built
+        .specular
         .iter()
         .map(|(k, sat)| Ok((*k, (iso(sat)?, sat.s_max()))))
         .collect::<Result<BTreeMap<_, _>, String>>()?;
@@ -259,14 +279,11 @@ pub fn render_built_simd(
                 return Err("visibility tables of different sizes".to_string());
             }
             let mut s: Vec<Option<[f32; 3]>> = vec![None; pts.len()];
-            for (key, (views, s_max)) in &phong_views {
+            for (key, (views, s_max)) in &specular_views {
                 let sel: Vec<usize> = all
                     .iter()
                     .copied()
-                    .filter(|&k| {
-                        matches!(scene.materials[pts[k].1.material],
-                            Material::Phong { exponent, .. } if exponent.to_bits() == *key)
-                    })
+                    .filter(|&k| spec_key(&scene.materials[pts[k].1.material]) == Some(*key))
                     .collect();
                 if sel.is_empty() {
                     continue;
