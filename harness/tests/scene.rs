@@ -540,13 +540,15 @@ fn rsl_simd_path_matches_the_scalar_path_pixel_by_pixel() {
     assert!(lit > 1000, "{lit}");
 }
 
-/// GGX materials (core's `Ggx` with an RGB tint): the path tracer samples them (the
-/// material unit tests check its density and core's values), the `rsl` method carries them
-/// through a GGX BRDF SAT per `(f0, α)` and stays within 1.5 % noise-corrected relative
-/// L2 of the path tracer (2048 samples; the test prints the measured figure),
+/// GGX materials (core's `Ggx` with an RGB tint) and Lafortune lobes under an
+/// environment: the path tracer samples them (the material unit tests check its density
+/// and core's values), the `rsl` method carries them through a BRDF SAT per GGX `(f0, α)`
+/// and per Lafortune lobe and stays within 1.5 % noise-corrected relative L2 of the path
+/// tracer (2048 samples; the test prints the measured figure), and its SIMD path matches
+/// its scalar path per pixel within the moments kernel's tolerance;
 /// and the lobe methods refuse them by name; a roughness out of range names its field.
 #[test]
-fn ggx_materials_in_path_and_rsl() {
+fn ggx_and_lafortune_materials_in_path_and_rsl() {
     use steradian_harness::scene::render::{self, Method};
     use steradian_harness::scene::rsl;
     let json = r#"{
@@ -554,11 +556,13 @@ fn ggx_materials_in_path_and_rsl() {
       "materials": {
         "floor": {"lambert": {"albedo": [0.6, 0.6, 0.6]}},
         "metal": {"ggx": {"diffuse": [0.05, 0.05, 0.05], "specular": [0.9, 0.7, 0.4], "f0": 0.9, "roughness": 0.25}},
-        "plastic": {"ggx": {"diffuse": [0.5, 0.1, 0.1], "specular": [0.5, 0.5, 0.5], "f0": 0.04, "roughness": 0.1}}
+        "plastic": {"ggx": {"diffuse": [0.5, 0.1, 0.1], "specular": [0.5, 0.5, 0.5], "f0": 0.04, "roughness": 0.1}},
+        "gold": {"lafortune": {"diffuse": [0.25, 0.18, 0.05], "lobes": [{"c": [-1, -1, 1], "exponent": 30, "rho": [0.6, 0.45, 0.15]}, {"c": [-0.5, -0.5, 0.9], "exponent": 5, "rho": [0.3, 0.2, 0.1]}]}}
       },
       "spheres": [
         {"center": [-0.5, 0, 0.6], "radius": 0.6, "material": "metal"},
-        {"center": [0.9, -0.3, 0.4], "radius": 0.4, "material": "plastic"}
+        {"center": [0.9, -0.3, 0.4], "radius": 0.4, "material": "plastic"},
+        {"center": [0.6, 1.0, 0.5], "radius": 0.5, "material": "gold"}
       ],
       "planes": [{"point": [0, 0, 0], "normal": [0, 0, 1], "material": "floor"}],
       "lights": [{"environment": {"file": "city.exr", "scale": 1.0}}]
@@ -577,6 +581,21 @@ fn ggx_materials_in_path_and_rsl() {
     eprintln!("ggx rsl {m:?}");
     assert!(m.rel_l2_noise_corrected < 0.015, "{m:?}");
     assert!(m.shaded_pixels > 300);
+    let o = rsl::Options::default();
+    let built = rsl::build(&s, &o).unwrap();
+    assert_eq!(
+        built.specular.len(),
+        4,
+        "two GGX parts and two Lafortune lobes"
+    );
+    let simd = rsl::render_built_simd(&s, &built, &o, &ProgressBar::hidden()).unwrap();
+    for (a, b) in img.data.iter().zip(&simd.data) {
+        let mx = a.iter().cloned().fold(0.0, f64::max);
+        for c in 0..3 {
+            let tol = steradian_simd::rsl::shade::MOMENTS_REL_TOL as f64 * mx.max(1e-30);
+            assert!((a[c] - b[c]).abs() <= tol, "{a:?} vs {b:?}");
+        }
+    }
     // The lobe methods have no cosine-lobe form of GGX.
     let lit = json.replace(
         r#"{"environment": {"file": "city.exr", "scale": 1.0}}"#,

@@ -165,8 +165,8 @@ pub fn plan(scene: &Scene, o: &Options) -> Result<Plan, String> {
             p.push(PlanItem {
                 item: "brdf_sats".into(),
                 value: json!(r.sat_target),
-                reason: "one Lambert SAT and one per distinct Phong exponent, fitted to this \
-                         target; Lafortune lobes are not carried"
+                reason: "one Lambert SAT and one per distinct specular part (Phong exponent, \
+                         GGX (f0, roughness), Lafortune lobe), fitted to this target"
                     .into(),
             });
             p.push(PlanItem {

@@ -6,10 +6,10 @@
 //!   texels per face and decomposed into `K` RSLs by bottom-up merging
 //!   ([`crate::env::decompose`]).
 //! - BRDF SATs are fitted for what the scene's materials need: one for the diffuse part
-//!   (Lambert, albedo 1, times each material's diffuse RGB) and one per distinct Phong
-//!   exponent or GGX `(f0, α)` for the specular part (modified Phong with `k_s = 1`, or
-//!   core's `Ggx` with `k_d = 0`, times the specular RGB).
-//!   Lafortune lobes are not carried by this method (their diffuse part is).
+//!   (Lambert, albedo 1, times each material's diffuse RGB) and one per distinct specular
+//!   part ([`SpecKey`]): a Phong exponent, a GGX `(f0, α)` or a Lafortune lobe (modified
+//!   Phong with `k_s = 1`, core's `Ggx` with `k_d = 0`, or the lobe with `ρ = 1`), times
+//!   the specular RGB or the lobe's `ρ`.
 //! - Visibility at a point is the coverage map of the caps of every other sphere, and of
 //!   every plane the point is not on (a plane seen from a point off it is exactly the
 //!   hemisphere of directions toward it: a cap of half-angle π/2), on an
@@ -24,6 +24,7 @@ use indicatif::ProgressBar;
 use steradian_core::frame::Frame;
 use steradian_core::lobe::brdf::{Ggx, Lambert, Phong};
 use steradian_core::lobe::cap::SphericalCap;
+use steradian_core::lobe::{Lafortune, LafortuneLobe};
 use steradian_core::rsl::brdf_sat::BrdfSat;
 use steradian_core::rsl::shade::{self, ShadeLight};
 use steradian_core::rsl::vis_moments::VisMoments;
@@ -104,20 +105,10 @@ pub fn build(scene: &Scene, o: &Options) -> Result<Built, String> {
     );
     let mut specular = BTreeMap::new();
     for m in &scene.materials {
-        let Some(key) = spec_key(m) else { continue };
-        if let std::collections::btree_map::Entry::Vacant(e) = specular.entry(key) {
-            let sat = match *m {
-                Material::Phong { exponent, .. } => {
-                    let b = Phong::new(0.0, 1.0, exponent as f32).map_err(|e| e.to_string())?;
-                    crate::shade::fit_sat(&b, &refs, o.sat_target)
-                }
-                Material::Ggx { f0, alpha, .. } => {
-                    let b = Ggx::new(0.0, f0 as f32, alpha as f32).map_err(|e| e.to_string())?;
-                    crate::shade::fit_sat(&b, &refs, o.sat_target)
-                }
-                _ => continue,
-            };
-            e.insert(sat);
+        for (key, _) in specular_parts(m) {
+            if let std::collections::btree_map::Entry::Vacant(e) = specular.entry(key) {
+                e.insert(fit_part(key, &refs, o.sat_target)?);
+            }
         }
     }
     Ok(Built {
@@ -165,35 +156,80 @@ pub fn point_moments(
     Some((frame, moments))
 }
 
-/// The reflected radiance from the diffuse and specular integrals `d`, `s` (each
-/// [`shade::shade_moments`] with the Lambert and the material's Phong SAT).
-fn combine(mat: &Material, d: [f32; 3], s: Option<[f32; 3]>) -> Rgb {
+/// A specular BRDF the method fits one SAT for, with unit scale: modified Phong
+/// (`k_s = 1`) of an exponent, core's `Ggx` (`k_d = 0`) of `(f0, α)`, or one Lafortune
+/// lobe (`ρ = 1`) of `(c, c_z, e)`; parameters as `f64` bits.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
+pub enum SpecKey {
+    /// Modified Phong exponent.
+    Phong(u64),
+    /// GGX `(f0, α)`.
+    Ggx(u64, u64),
+    /// A Lafortune lobe `(c, c_z, e)`.
+    Lafortune(u64, u64, u64),
+}
+
+/// The specular parts of a material: each SAT it needs and the RGB that scales it
+/// (Phong's and GGX's `specular`, each Lafortune lobe's `ρ`).
+pub fn specular_parts(mat: &Material) -> Vec<(SpecKey, Rgb)> {
+    match mat {
+        Material::Lambert { .. } => Vec::new(),
+        Material::Phong {
+            specular, exponent, ..
+        } => vec![(SpecKey::Phong(exponent.to_bits()), *specular)],
+        Material::Ggx {
+            specular,
+            f0,
+            alpha,
+            ..
+        } => vec![(SpecKey::Ggx(f0.to_bits(), alpha.to_bits()), *specular)],
+        Material::Lafortune { lobes, .. } => lobes
+            .iter()
+            .map(|l| {
+                let k = SpecKey::Lafortune(l.c.to_bits(), l.cz.to_bits(), l.exponent.to_bits());
+                (k, l.rho)
+            })
+            .collect(),
+    }
+}
+
+/// The BRDF SAT of one specular part, fitted to `target` over the decompositions.
+fn fit_part(
+    key: SpecKey,
+    refs: &[&crate::env::decompose::Decomposition],
+    target: f32,
+) -> Result<BrdfSat, String> {
+    let f = |b: u64| f64::from_bits(b) as f32;
+    let e = |e: steradian_core::Error| e.to_string();
+    Ok(match key {
+        SpecKey::Phong(x) => {
+            crate::shade::fit_sat(&Phong::new(0.0, 1.0, f(x)).map_err(e)?, refs, target)
+        }
+        SpecKey::Ggx(f0, a) => {
+            crate::shade::fit_sat(&Ggx::new(0.0, f(f0), f(a)).map_err(e)?, refs, target)
+        }
+        SpecKey::Lafortune(c, cz, x) => {
+            let lobe = LafortuneLobe {
+                c: steradian_core::Vec3::new(f(c), f(c), f(cz)),
+                exponent: f(x),
+                rho: 1.0,
+            };
+            crate::shade::fit_sat(&Lafortune::new([lobe]).map_err(e)?, refs, target)
+        }
+    })
+}
+
+/// The reflected radiance from the diffuse integral `d` and the integral of each specular
+/// part with its RGB scale ([`shade::shade_moments`] with the Lambert SAT and each part's).
+fn combine(mat: &Material, d: [f32; 3], parts: &[(Rgb, [f32; 3])]) -> Rgb {
     let diffuse = mat.diffuse();
     let mut out: Rgb = core::array::from_fn(|c| diffuse[c] * d[c] as f64);
-    if let (Material::Phong { specular, .. } | Material::Ggx { specular, .. }, Some(s)) = (mat, s) {
+    for (scale, s) in parts {
         for c in 0..3 {
-            out[c] += specular[c] * s[c] as f64;
+            out[c] += scale[c] * s[c] as f64;
         }
     }
     out
-}
-
-/// Which specular SAT a material needs: `(0, exponent bits, 0)` for modified Phong,
-/// `(1, f0 bits, α bits)` for GGX, `None` for the others.
-pub type SpecKey = (u8, u64, u64);
-
-/// The [`SpecKey`] of a material.
-pub fn spec_key(mat: &Material) -> Option<SpecKey> {
-    match *mat {
-        Material::Phong { exponent, .. } => Some((0, exponent.to_bits(), 0)),
-        Material::Ggx { f0, alpha, .. } => Some((1, f0.to_bits(), alpha.to_bits())),
-        _ => None,
-    }
-}
-
-/// The specular SAT of a material, if it has one.
-fn specular_sat<'a>(b: &'a Built, mat: &Material) -> Option<&'a BrdfSat> {
-    b.specular.get(&spec_key(mat)?)
 }
 
 /// The reflected radiance at a surface point.
@@ -210,9 +246,17 @@ pub fn shade_point(
     let wo = p.wo.as_vec3();
     let mat = &scene.materials[p.material];
     let d = shade::shade_moments(&frame, wo, &b.lambert, &moments, &b.lights);
-    let s =
-        specular_sat(b, mat).map(|sat| shade::shade_moments(&frame, wo, sat, &moments, &b.lights));
-    combine(mat, d, s)
+    let parts: Vec<(Rgb, [f32; 3])> = specular_parts(mat)
+        .into_iter()
+        .filter_map(|(key, scale)| {
+            let sat = b.specular.get(&key)?;
+            Some((
+                scale,
+                shade::shade_moments(&frame, wo, sat, &moments, &b.lights),
+            ))
+        })
+        .collect();
+    combine(mat, d, &parts)
 }
 
 /// [`render_built`] through the SIMD moments kernel: per row, each surface point's moment
@@ -278,13 +322,18 @@ pub fn render_built_simd(
             if !shade_moments_batch(&input(&all), &lambert, &built.lights, &mut d) {
                 return Err("visibility tables of different sizes".to_string());
             }
-            let mut s: Vec<Option<[f32; 3]>> = vec![None; pts.len()];
+            let mut s: Vec<Vec<(Rgb, [f32; 3])>> = vec![Vec::new(); pts.len()];
             for (key, (views, s_max)) in &specular_views {
-                let sel: Vec<usize> = all
+                // The points with this part, and its scale at each.
+                let (sel, scales): (Vec<usize>, Vec<Rgb>) = all
                     .iter()
-                    .copied()
-                    .filter(|&k| spec_key(&scene.materials[pts[k].1.material]) == Some(*key))
-                    .collect();
+                    .filter_map(|&k| {
+                        specular_parts(&scene.materials[pts[k].1.material])
+                            .into_iter()
+                            .find(|(pk, _)| pk == key)
+                            .map(|(_, scale)| (k, scale))
+                    })
+                    .unzip();
                 if sel.is_empty() {
                     continue;
                 }
@@ -296,12 +345,12 @@ pub fn render_built_simd(
                 if !shade_moments_batch(&input(&sel), &tables, &built.lights, &mut out) {
                     return Err("visibility tables of different sizes".to_string());
                 }
-                for (k, v) in sel.into_iter().zip(out) {
-                    s[k] = Some(v);
+                for ((k, v), scale) in sel.into_iter().zip(out).zip(scales) {
+                    s[k].push((scale, v));
                 }
             }
             for (k, (i, p, _, _)) in pts.iter().enumerate() {
-                row[*i] = combine(&scene.materials[p.material], d[k], s[k]);
+                row[*i] = combine(&scene.materials[p.material], d[k], &s[k]);
             }
             bar.inc(1);
             Ok(row)
