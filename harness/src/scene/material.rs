@@ -124,6 +124,20 @@ fn power_cosine_pdf(axis: DVec3, e: f64, wi: DVec3) -> f64 {
     }
 }
 
+/// The energy bound of a diffuse-plus-specular material: `diffuse + specular ≤ 1` per
+/// channel (the error names the material kind).
+fn energy(kind: &str, diffuse: Rgb, specular: Rgb) -> Result<(), String> {
+    for c in 0..3 {
+        if diffuse[c] + specular[c] > 1.0 {
+            return Err(format!(
+                "{kind}: diffuse + specular must be ≤ 1 per channel (channel {c}: {})",
+                diffuse[c] + specular[c]
+            ));
+        }
+    }
+    Ok(())
+}
+
 impl Material {
     /// From the validated file form; the error names the sub-field.
     pub fn from_file(m: &MaterialFile) -> Result<Material, String> {
@@ -134,14 +148,7 @@ impl Material {
                 specular,
                 exponent,
             } => {
-                for c in 0..3 {
-                    if diffuse.0[c] + specular.0[c] > 1.0 {
-                        return Err(format!(
-                            "phong: diffuse + specular must be ≤ 1 per channel (channel {c}: {})",
-                            diffuse.0[c] + specular.0[c]
-                        ));
-                    }
-                }
+                energy("phong", diffuse.0, specular.0)?;
                 Material::Phong {
                     diffuse: diffuse.0,
                     specular: specular.0,
@@ -154,14 +161,7 @@ impl Material {
                 f0,
                 roughness,
             } => {
-                for c in 0..3 {
-                    if diffuse.0[c] + specular.0[c] > 1.0 {
-                        return Err(format!(
-                            "ggx: diffuse + specular must be ≤ 1 per channel (channel {c}: {})",
-                            diffuse.0[c] + specular.0[c]
-                        ));
-                    }
-                }
+                energy("ggx", diffuse.0, specular.0)?;
                 Material::Ggx {
                     diffuse: diffuse.0,
                     specular: specular.0,
