@@ -6,7 +6,7 @@
 //! Per scene of [`SCENES`] (at [`WIDTH`] columns): the reference is the path tracer at
 //! [`REFERENCE_SPP`] samples per pixel ([`ENVIRONMENT_REFERENCE_SPP`] for `environment`,
 //! whose reference is the noisiest per sample) (direct light for `lobes` and `cluster`, one bounce
-//! for `room`); the path tracer's curve is the same tracer with other seeds at 1–64
+//! for `room`); the path tracer's curve is the same tracer with other seeds at 1–256
 //! samples. The `lobes` method's curve is its pruning threshold, with the L2 cap fit and
 //! one lobe per occluder (instead of the default energy-preserving fit and quadtree mask)
 //! beside it; the `hvl` method's curve is its HVL count, with the paper's choice of no
@@ -49,7 +49,7 @@ fn reference_spp(name: &str) -> u32 {
     }
 }
 /// The path tracer's own curve.
-const PATH_SPP: &[u32] = &[1, 2, 4, 8, 16, 64];
+const PATH_SPP: &[u32] = &[1, 2, 4, 8, 16, 64, 256];
 /// Pruning thresholds of the `lobes` curve.
 const THRESHOLDS: &[f32] = &[0.0, 1e-4, 1e-3, 1e-2, 5e-2];
 /// Reflective-shadow-map face sides of the `hvl` curve.
@@ -486,7 +486,7 @@ pub fn section(_opts: &Options) -> Result<Section, Box<dyn Error>> {
             .collect();
         writeln!(
             summary,
-            "  {} ({}, {} bounce(s)): {:.2e} of max radiance, RMSE {:.4}, in {:.1} ms ({}); path tracer {:.2e} at 1 spp, {:.2e} at 64 spp; reference noise {:.1e}; equal-error cost ratio {:.1}×",
+            "  {} ({}, {} bounce(s)): {:.2e} of max radiance, RMSE {:.4}, in {:.1} ms ({}); path tracer {:.2e} at 1 spp, {:.2e} at 256 spp; reference noise {:.1e}; equal-error cost ratio {:.1}×",
             r.name,
             r.method,
             r.bounces,
