@@ -97,6 +97,9 @@ enum Command {
         /// kernel otherwise; the other methods are scalar).
         #[arg(long)]
         scalar: bool,
+        /// Shade on the wgpu backend (rsl; an error without an adapter).
+        #[arg(long, conflicts_with = "scalar")]
+        gpu: bool,
     },
 }
 
@@ -154,6 +157,7 @@ fn main() -> ExitCode {
             seed,
             quiet,
             scalar,
+            gpu,
         } => {
             let o = scene::render::Options {
                 method: scene::render::Method::Path,
@@ -165,6 +169,7 @@ fn main() -> ExitCode {
                 seed,
                 quiet,
                 scalar,
+                gpu,
             };
             match render(&spec, width, &method, o) {
                 Ok(()) => ExitCode::SUCCESS,

@@ -817,24 +817,37 @@ pub fn shade_points_moments_gpu(
     lights: &[ShadeLight],
     max_table_bytes: usize,
 ) -> Result<Vec<[f32; 3]>, crate::backend::BackendError> {
+    let refs: Vec<&VisMoments> = moments.iter().collect();
+    shade_moments_gpu_at(gpu, &scene.points, sat, &refs, lights, max_table_bytes)
+}
+
+/// [`shade_points_moments_gpu`] at any points (point `i` with `moments[i]`; only each
+/// point's frame and view are read).
+pub fn shade_moments_gpu_at(
+    gpu: &mut crate::backend::gpu::Gpu,
+    points: &[ShadePoint],
+    sat: &BrdfSat,
+    moments: &[&VisMoments],
+    lights: &[ShadeLight],
+    max_table_bytes: usize,
+) -> Result<Vec<[f32; 3]>, crate::backend::BackendError> {
     use crate::backend::BackendError;
-    if moments.len() != scene.points.len() {
+    if moments.len() != points.len() {
         return Err(BackendError(format!(
             "shade-moments: {} points, {} moment tables",
-            scene.points.len(),
+            points.len(),
             moments.len()
         )));
     }
     let polar = iso_views(sat).map_or(0, |v| v.len());
-    let vn = moments.first().map_or(1, VisMoments::side);
+    let vn = moments.first().map_or(1, |m| m.side());
     let (fixed, per_point) =
         shade_gpu::moments_words(sat.resolution().grid, polar, lights.len(), vn);
     let chunk = (max_table_bytes / 4).saturating_sub(fixed) / per_point;
     let chunk = chunk.max(1);
     let mut out = Vec::with_capacity(moments.len());
-    for (points, ms) in scene.points.chunks(chunk).zip(moments.chunks(chunk)) {
-        let refs: Vec<&VisMoments> = ms.iter().collect();
-        let table = gpu_moments_table(sat, &refs, lights).ok_or_else(|| {
+    for (points, ms) in points.chunks(chunk).zip(moments.chunks(chunk)) {
+        let table = gpu_moments_table(sat, ms, lights).ok_or_else(|| {
             BackendError("shade-moments: anisotropic BRDF SAT or maps of different sizes".into())
         })?;
         let input = gpu_input_points(points);

@@ -617,3 +617,53 @@ fn ggx_and_lafortune_materials_in_path_and_rsl() {
         "{e}"
     );
 }
+
+/// The `rsl` method's wgpu path (`render_built_gpu`: `wgsl::SHADE_MOMENTS` per batch)
+/// gives every pixel of the scalar path within `SHADE_MOMENTS_REL_TOL` of the pixel's
+/// largest channel, on a scene with Phong, GGX and Lafortune parts.
+#[test]
+fn rsl_gpu_path_matches_the_scalar_path_pixel_by_pixel() {
+    use crate::common::gpu as gpu_common;
+    use steradian_core::wgsl::SHADE_MOMENTS_REL_TOL;
+    use steradian_harness::scene::rsl;
+    let Some(mut gpu) = gpu_common::gpu() else {
+        return;
+    };
+    let json = r#"{
+      "camera": {"eye": [0, -5, 1.6], "target": [0, 0, 0.6], "up": [0, 0, 1], "fov_y": 40, "width": 40, "height": 30},
+      "materials": {
+        "floor": {"lambert": {"albedo": [0.6, 0.6, 0.6]}},
+        "glossy": {"phong": {"diffuse": [0.3, 0.3, 0.35], "specular": [0.5, 0.5, 0.5], "exponent": 60}},
+        "metal": {"ggx": {"diffuse": [0.05, 0.05, 0.05], "specular": [0.9, 0.7, 0.4], "f0": 0.9, "roughness": 0.25}},
+        "gold": {"lafortune": {"diffuse": [0.25, 0.18, 0.05], "lobes": [{"c": [-1, -1, 1], "exponent": 30, "rho": [0.6, 0.45, 0.15]}]}}
+      },
+      "spheres": [
+        {"center": [-0.9, 0, 0.6], "radius": 0.6, "material": "metal"},
+        {"center": [0.7, -0.3, 0.5], "radius": 0.5, "material": "glossy"},
+        {"center": [0.4, 1.2, 0.5], "radius": 0.5, "material": "gold"}
+      ],
+      "planes": [{"point": [0, 0, 0], "normal": [0, 0, 1], "material": "floor"}],
+      "lights": [{"environment": {"file": "city.exr", "scale": 1.0}}]
+    }"#;
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenes");
+    let s = Scene::from_json(json, &dir).unwrap();
+    let o = rsl::Options::default();
+    let built = rsl::build(&s, &o).unwrap();
+    let hidden = ProgressBar::hidden();
+    let scalar = rsl::render_built(&s, &built, &o, &hidden);
+    let on_gpu = rsl::render_built_gpu(&s, &built, &o, &mut gpu, &hidden).unwrap();
+    let (mut lit, mut worst) = (0, 0.0f64);
+    for (a, b) in scalar.data.iter().zip(&on_gpu.data) {
+        let m = a.iter().cloned().fold(0.0, f64::max);
+        lit += (m > 0.0) as usize;
+        for c in 0..3 {
+            let e = (a[c] - b[c]).abs() / m.max(1e-30);
+            worst = worst.max(if m > 0.0 { e } else { (a[c] - b[c]).abs() });
+        }
+    }
+    gpu_common::say(&format!(
+        "rsl scene on wgpu: {lit} lit pixels, worst {worst:.2e} of the pixel's largest channel"
+    ));
+    assert!(lit > 800, "{lit}");
+    assert!(worst <= SHADE_MOMENTS_REL_TOL as f64, "{worst}");
+}

@@ -242,7 +242,13 @@ fn hvl_settings(scene: &Scene) -> (Vec<Setting<'_>>, Vec<Setting<'_>>) {
 /// The label suffix of a setting shaded by a SIMD kernel.
 const SIMD_LABEL: &str = ", SIMD kernel";
 
-fn rsl_settings(scene: &Scene) -> (Vec<Setting<'_>>, Vec<Setting<'_>>) {
+/// The label suffix of a setting shaded on the wgpu backend.
+const WGPU_LABEL: &str = ", wgpu";
+
+fn rsl_settings<'a>(
+    scene: &'a Scene,
+    gpu: Option<&'a std::sync::Mutex<crate::backend::gpu::Gpu>>,
+) -> (Vec<Setting<'a>>, Vec<Setting<'a>>) {
     let d = rsl::Options::default();
     let setting = |k: usize, simd: bool| {
         let o = rsl::Options { k, ..d };
@@ -266,7 +272,28 @@ fn rsl_settings(scene: &Scene) -> (Vec<Setting<'_>>, Vec<Setting<'_>>) {
         }
     };
     let curve = RSL_KS.iter().map(|&k| setting(k, false)).collect();
-    (curve, vec![setting(d.k, true)])
+    let mut variants = vec![setting(d.k, true)];
+    if let Some(gpu) = gpu {
+        let (built, build_seconds) = timed(|| rsl::build(scene, &d));
+        variants.push(Setting {
+            label: format!("K = {}{WGPU_LABEL}", d.k),
+            render: Box::new(move || {
+                let blank =
+                    || Image::new(scene.camera.width as usize, scene.camera.height as usize);
+                let img = match (&built, gpu.lock()) {
+                    (Ok(b), Ok(mut g)) => {
+                        rsl::render_built_gpu(scene, b, &d, &mut g, &ProgressBar::hidden())
+                            .unwrap_or_else(|_| blank())
+                    }
+                    _ => blank(),
+                };
+                (img, None)
+            }),
+            default: false,
+            build_seconds: Some(build_seconds),
+        });
+    }
+    (curve, variants)
 }
 
 fn png(img: &Image) -> Result<Vec<u8>, String> {
@@ -284,6 +311,7 @@ fn measure_scene(
     name: &'static str,
     method: &'static str,
     bounces: u32,
+    gpu: Option<&std::sync::Mutex<crate::backend::gpu::Gpu>>,
     bar: &ProgressBar,
 ) -> Result<SceneResult, Box<dyn Error>> {
     let mut scene = Scene::load(&format!("builtin:{name}"))?;
@@ -310,7 +338,7 @@ fn measure_scene(
     bar.inc(1);
     let (curve_settings, variant_settings) = match method {
         "hvl" => hvl_settings(&scene),
-        "rsl" => rsl_settings(&scene),
+        "rsl" => rsl_settings(&scene, gpu),
         _ => lobes_settings(&scene),
     };
     let measure = |st: &Setting<'_>| -> Result<(Point, Image), String> {
@@ -350,7 +378,8 @@ fn measure_scene(
         .map(|st| measure(st).map(|(p, _)| p))
         .collect::<Result<Vec<_>, _>>()?;
     // Throughput on one core: the default setting (scalar) and, for `rsl`, its SIMD
-    // variant, each the best of two renders in a one-thread pool.
+    // variant and its wgpu variant (one core building the visibility tables, the adapter
+    // shading), each the best of two renders in a one-thread pool.
     let surface_points = (0..scene.camera.height)
         .flat_map(|j| (0..scene.camera.width).map(move |i| (i, j)))
         .filter(|&(i, j)| matches!(scene.see(&scene.camera.centre_ray(i, j)), Seen::Surface(_)))
@@ -361,12 +390,15 @@ fn measure_scene(
         .iter()
         .filter(|st| st.default)
         .map(|st| ("scalar", st))
-        .chain(
-            variant_settings
-                .iter()
-                .filter(|st| st.label.ends_with(SIMD_LABEL))
-                .map(|st| ("simd", st)),
-        )
+        .chain(variant_settings.iter().filter_map(|st| {
+            if st.label.ends_with(SIMD_LABEL) {
+                Some(("simd", st))
+            } else if st.label.ends_with(WGPU_LABEL) {
+                Some(("wgpu", st))
+            } else {
+                None
+            }
+        }))
     {
         let s = (0..2)
             .map(|_| timed(|| pool.install(|| (st.render)())).1)
@@ -454,12 +486,14 @@ pub const SCENES: &[(&str, &str, u32)] = &[
 ];
 
 /// The report section (see the module docs).
-pub fn section(_opts: &Options) -> Result<Section, Box<dyn Error>> {
+pub fn section(opts: &Options) -> Result<Section, Box<dyn Error>> {
+    let (gpu, gpu_note) = crate::backend::gpu::if_requested(opts.gpu);
+    let gpu = gpu.map(std::sync::Mutex::new);
     let bar = ProgressBar::new(3 * SCENES.len() as u64);
     bar.set_message("scenes");
     let results = SCENES
         .iter()
-        .map(|&(n, m, b)| measure_scene(n, m, b, &bar))
+        .map(|&(n, m, b)| measure_scene(n, m, b, gpu.as_ref(), &bar))
         .collect::<Result<Vec<_>, _>>()?;
     bar.finish_and_clear();
     let mut summary = String::new();
@@ -471,8 +505,10 @@ pub fn section(_opts: &Options) -> Result<Section, Box<dyn Error>> {
         "<p>Built-in scenes at {WIDTH} columns. Reference: the path tracer at {REFERENCE_SPP} \
          samples per pixel ({ENVIRONMENT_REFERENCE_SPP} on <code>environment</code>; direct light; one bounce for <code>room</code>). Errors over shaded, \
          non-silhouette pixels (see the README, \"Errors\"); times are whole renders on this \
-         machine's thread pool, the best of three for the methods.</p>"
+         machine's thread pool, the best of three for the methods. wgpu: {}.</p>",
+        gpu_note
     )?;
+    writeln!(summary, "  wgpu: {gpu_note}")?;
     for r in &results {
         let d = r
             .curve
@@ -593,7 +629,7 @@ pub fn section(_opts: &Options) -> Result<Section, Box<dyn Error>> {
         title: "Scenes: whole images against the path tracer".into(),
         summary,
         html,
-        data: json!({ "scenes": data }),
+        data: json!({ "scenes": data, "gpu": gpu_note }),
         files,
     })
 }

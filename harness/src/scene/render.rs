@@ -72,6 +72,8 @@ pub struct Options {
     pub quiet: bool,
     /// Shade with the scalar kernels (`rsl` uses its SIMD kernel otherwise).
     pub scalar: bool,
+    /// Shade on the wgpu backend (`rsl` only; an error without an adapter).
+    pub gpu: bool,
 }
 
 impl Default for Options {
@@ -86,6 +88,7 @@ impl Default for Options {
             seed: 1,
             quiet: false,
             scalar: false,
+            gpu: false,
         }
     }
 }
@@ -131,12 +134,29 @@ pub struct Plan {
     pub rsl: super::rsl::Options,
 }
 
+/// The `rsl` kernel the options select.
+fn kernel_name(o: &Options) -> &'static str {
+    if o.gpu {
+        "wgpu"
+    } else if o.scalar {
+        "scalar"
+    } else {
+        "simd"
+    }
+}
+
 /// The plan of a method for a scene: what it builds and why.
 pub fn plan(scene: &Scene, o: &Options) -> Result<Plan, String> {
     let mut p = Vec::new();
     let mut lo = lobes::Options::default();
     let mut r = super::rsl::Options::default();
     let mut hv = super::hvl::Options::default();
+    if o.gpu && o.method != Method::Rsl {
+        return Err(format!(
+            "--gpu: only method rsl has a wgpu path (not {})",
+            o.method.name()
+        ));
+    }
     match o.method {
         Method::Path => {
             p.push(PlanItem {
@@ -179,11 +199,16 @@ pub fn plan(scene: &Scene, o: &Options) -> Result<Plan, String> {
             });
             p.push(PlanItem {
                 item: "kernel".into(),
-                value: json!(if o.scalar { "scalar" } else { "simd" }),
-                reason: if o.scalar {
+                value: json!(kernel_name(o)),
+                reason: if o.gpu {
+                    "--gpu: the WGSL moments kernel on the wgpu backend, 4096 points per batch \
+                     (their visibility tables built on the CPU)"
+                        .into()
+                } else if o.scalar {
                     "--scalar: the scalar moments kernel, one point at a time".into()
                 } else {
-                    "the SIMD moments kernel, eight points at a time (--scalar for the scalar one)"
+                    "the SIMD moments kernel, eight points at a time (--scalar for the scalar \
+                     one, --gpu for wgpu)"
                         .into()
                 },
             });
@@ -327,7 +352,11 @@ pub fn run(scene: &Scene, scene_name: &str, o: &Options, plan: &Plan) -> Result<
             let t = Instant::now();
             let built = super::rsl::build(scene, &plan.rsl)?;
             let build_seconds = t.elapsed().as_secs_f64();
-            let img = if o.scalar {
+            let img = if o.gpu {
+                let mut gpu = crate::backend::gpu::try_gpu()
+                    .map_err(|e| format!("--gpu: no wgpu adapter: {e}"))?;
+                super::rsl::render_built_gpu(scene, &built, &plan.rsl, &mut gpu, &b)?
+            } else if o.scalar {
                 super::rsl::render_built(scene, &built, &plan.rsl, &b)
             } else {
                 super::rsl::render_built_simd(scene, &built, &plan.rsl, &b)?
@@ -338,7 +367,7 @@ pub fn run(scene: &Scene, scene_name: &str, o: &Options, plan: &Plan) -> Result<
                 json!({
                     "rsls": plan.rsl.k,
                     "build_seconds": build_seconds,
-                    "kernel": if o.scalar { "scalar" } else { "simd" },
+                    "kernel": kernel_name(o),
                 }),
             )
         }

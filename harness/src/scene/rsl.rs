@@ -378,3 +378,106 @@ pub fn render_built(scene: &Scene, built: &Built, o: &Options, bar: &ProgressBar
     });
     img
 }
+
+/// Surface points shaded per GPU batch by [`render_built_gpu`] (their moment tables are
+/// built on the CPU first: about 26 KB each at the default 32² maps).
+pub const GPU_BATCH: usize = 4096;
+
+/// [`render_built`] on the wgpu backend: the surface points' moment tables as in
+/// [`shade_point`] (CPU, in parallel), then `wgsl::SHADE_MOMENTS` for the Lambert SAT and
+/// each specular part's SAT ([`crate::shade::shade_moments_gpu_at`]), [`GPU_BATCH`] points
+/// at a time. Each pixel is within `steradian_core::wgsl::SHADE_MOMENTS_REL_TOL` of
+/// [`render_built`] (relative to the pixel's largest channel; the GPU scene test asserts
+/// it). `Err` for a device error or a BRDF SAT the kernel does not take (anisotropic).
+pub fn render_built_gpu(
+    scene: &Scene,
+    built: &Built,
+    o: &Options,
+    gpu: &mut crate::backend::gpu::Gpu,
+    bar: &ProgressBar,
+) -> Result<Image, String> {
+    use crate::shade::{GPU_MOMENTS_MAX_TABLE_BYTES, ShadePoint, shade_moments_gpu_at};
+    use rayon::prelude::*;
+
+    let cam = scene.camera;
+    let (w, h) = (cam.width as usize, cam.height as usize);
+    let mut img = Image::new(w, h);
+    // Every pixel's centre: lights and the environment as seen, surface points queued.
+    let mut queue = Vec::new();
+    bar.set_length((w * h) as u64);
+    for j in 0..h {
+        for i in 0..w {
+            match scene.see(&cam.centre_ray(i as u32, j as u32)) {
+                Seen::Radiance(l) => img.data[j * w + i] = l,
+                Seen::Surface(p) => queue.push((j * w + i, p)),
+            }
+        }
+    }
+    let run = |gpu: &mut crate::backend::gpu::Gpu,
+               pts: &[ShadePoint],
+               sat: &BrdfSat,
+               ms: &[&VisMoments]| {
+        shade_moments_gpu_at(
+            gpu,
+            pts,
+            sat,
+            ms,
+            &built.lights,
+            GPU_MOMENTS_MAX_TABLE_BYTES,
+        )
+        .map_err(|e| e.to_string())
+    };
+    for batch in queue.chunks(GPU_BATCH) {
+        let tables: Vec<Option<(Frame, VisMoments)>> = batch
+            .par_iter()
+            .map_init(
+                || vec![0.0f32; o.vis_side * o.vis_side],
+                |cov, (_, p)| point_moments(scene, o, p, cov),
+            )
+            .collect();
+        // The shaded points of the batch (those with tables) with their pixel.
+        let mut px = Vec::new();
+        let mut pts = Vec::new();
+        let mut ms = Vec::new();
+        for ((k, p), t) in batch.iter().zip(tables) {
+            if let Some((frame, m)) = t {
+                px.push((*k, p.material));
+                pts.push(ShadePoint {
+                    pos: p.x,
+                    frame,
+                    wo: p.wo.as_vec3(),
+                    occluders: Vec::new(),
+                });
+                ms.push(m);
+            }
+        }
+        let all: Vec<&VisMoments> = ms.iter().collect();
+        let d = run(gpu, &pts, &built.lambert, &all)?;
+        let mut parts: Vec<Vec<(Rgb, [f32; 3])>> = vec![Vec::new(); pts.len()];
+        for (key, sat) in &built.specular {
+            let (sel, scales): (Vec<usize>, Vec<Rgb>) = (0..pts.len())
+                .filter_map(|q| {
+                    specular_parts(&scene.materials[px[q].1])
+                        .into_iter()
+                        .find(|(pk, _)| pk == key)
+                        .map(|(_, scale)| (q, scale))
+                })
+                .unzip();
+            if sel.is_empty() {
+                continue;
+            }
+            let sub_pts: Vec<ShadePoint> = sel.iter().map(|&q| pts[q].clone()).collect();
+            let sub_ms: Vec<&VisMoments> = sel.iter().map(|&q| &ms[q]).collect();
+            let s = run(gpu, &sub_pts, sat, &sub_ms)?;
+            for ((&q, v), scale) in sel.iter().zip(s).zip(scales) {
+                parts[q].push((scale, v));
+            }
+        }
+        for (q, &(k, mi)) in px.iter().enumerate() {
+            img.data[k] = combine(&scene.materials[mi], d[q], &parts[q]);
+        }
+        bar.inc(batch.len() as u64);
+    }
+    bar.set_position((w * h) as u64);
+    Ok(img)
+}
