@@ -667,3 +667,49 @@ fn rsl_gpu_path_matches_the_scalar_path_pixel_by_pixel() {
     assert!(lit > 800, "{lit}");
     assert!(worst <= SHADE_MOMENTS_REL_TOL as f64, "{worst}");
 }
+
+/// `rsl` plans K from the target error (`choose_k`): the estimates fall with K, the chosen
+/// K is the smallest within half the target, a loose target takes a small K, and the
+/// render at the chosen K meets the target against the path tracer (plus four times the
+/// reference's noise) at 48 columns, with under half the noise-corrected relative L2 of
+/// the paper's K = 30.
+#[test]
+fn rsl_plans_k_from_the_target_error() {
+    use steradian_harness::scene::rsl;
+    let small = Small::new("environment", 48, 512, 0);
+    let o = rsl::Options::default();
+    let target = 0.0028;
+    let c = rsl::choose_k(&small.scene, &o, target).unwrap();
+    eprintln!("{c:?}");
+    let e: Vec<f64> = c.estimates.iter().map(|x| x.1).collect();
+    assert!(e.windows(2).all(|w| w[1] <= w[0]), "{e:?}");
+    let first = c.estimates.iter().find(|x| x.1 <= 0.5 * target).unwrap();
+    assert_eq!(first.0, c.k);
+    let loose = rsl::choose_k(&small.scene, &o, 0.05).unwrap();
+    assert!(loose.k < c.k, "{loose:?}");
+    let img = rsl::render(
+        &small.scene,
+        &rsl::Options { k: c.k, ..o },
+        &ProgressBar::hidden(),
+    )
+    .unwrap();
+    let m = small.errors(&img);
+    eprintln!("rsl at K = {}: {m:?}", c.k);
+    assert!(
+        m.mean_abs_over_max < target + 4.0 * m.reference_noise_over_max,
+        "{m:?}"
+    );
+    // Against the noise-free image the planned K is well below the paper's K = 30.
+    let paper = small.errors(
+        &rsl::render(
+            &small.scene,
+            &rsl::Options { k: 30, ..o },
+            &ProgressBar::hidden(),
+        )
+        .unwrap(),
+    );
+    assert!(
+        m.rel_l2_noise_corrected < 0.5 * paper.rel_l2_noise_corrected,
+        "{m:?} vs K = 30: {paper:?}"
+    );
+}

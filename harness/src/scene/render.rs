@@ -174,12 +174,30 @@ pub fn plan(scene: &Scene, o: &Options) -> Result<Plan, String> {
             if scene.environment.is_none() {
                 return Err("method rsl lights with an environment; this scene has none".into());
             }
+            // The coverage depth first: the choice of K shades probes with it.
+            use steradian_core::rsl::visibility::{DEPTH_BOUNDS, LEAF_DEPTH};
+            r.vis_depth = (0..=LEAF_DEPTH)
+                .find(|&d| (DEPTH_BOUNDS[d as usize].1 as f64) <= o.target_error / 10.0)
+                .unwrap_or(LEAF_DEPTH);
+            let choice = super::rsl::choose_k(scene, &r, o.target_error)?;
+            r.k = choice.k;
+            let est: Vec<String> = choice
+                .estimates
+                .iter()
+                .map(|(k, e)| format!("K = {k}: {e:.1e}"))
+                .collect();
             p.push(PlanItem {
                 item: "rsls".into(),
                 value: json!(r.k),
                 reason: format!(
-                    "K square lights from a 6 × {}² cube map (the RSL paper's K = 30)",
-                    r.face
+                    "K square lights from a 6 × {}² cube map: the smallest of {:?} whose \
+                     decomposition alone keeps {} probe pixels within half the target {} of \
+                     the largest ({}; the RSL paper uses K = 30)",
+                    r.face,
+                    super::rsl::K_CANDIDATES,
+                    super::rsl::K_PROBES.0 * super::rsl::K_PROBES.1,
+                    o.target_error,
+                    est.join(", ")
                 ),
             });
             p.push(PlanItem {
@@ -213,11 +231,7 @@ pub fn plan(scene: &Scene, o: &Options) -> Result<Plan, String> {
                 },
             });
             // The coarsest coverage whose visible solid angle is within a tenth of the
-            // target (the asserted bounds of `DEPTH_BOUNDS`).
-            use steradian_core::rsl::visibility::{DEPTH_BOUNDS, LEAF_DEPTH};
-            r.vis_depth = (0..=LEAF_DEPTH)
-                .find(|&d| (DEPTH_BOUNDS[d as usize].1 as f64) <= o.target_error / 10.0)
-                .unwrap_or(LEAF_DEPTH);
+            // target (the asserted bounds of `DEPTH_BOUNDS`), chosen above.
             p.push(PlanItem {
                 item: "coverage_depth".into(),
                 value: json!(r.vis_depth),

@@ -76,6 +76,28 @@ pub struct Built {
 
 /// Decomposes the environment and fits the SATs the materials need.
 pub fn build(scene: &Scene, o: &Options) -> Result<Built, String> {
+    let mut many = build_many(scene, o, &[o.k])?;
+    Ok(Built {
+        lights: many.lights.remove(0).1,
+        lambert: many.lambert,
+        specular: many.specular,
+    })
+}
+
+/// [`build`] for several `K` at once: one decomposition run (the partitions are nested)
+/// and one set of BRDF SATs fitted over all of them.
+pub struct BuiltMany {
+    /// `(K, lights)` per requested `K` (in the order asked).
+    pub lights: Vec<(usize, Vec<ShadeLight>)>,
+    /// The diffuse SAT.
+    pub lambert: BrdfSat,
+    /// The specular SATs by [`SpecKey`].
+    pub specular: BTreeMap<SpecKey, BrdfSat>,
+}
+
+/// The environment (times its scale) decomposed into each of `ks` square lights, and the
+/// SATs the materials need, fitted over every decomposition.
+pub fn build_many(scene: &Scene, o: &Options, ks: &[usize]) -> Result<BuiltMany, String> {
     let env = scene
         .environment
         .as_ref()
@@ -89,14 +111,20 @@ pub fn build(scene: &Scene, o: &Options) -> Result<Built, String> {
     let eq =
         Equirect::new(env.image.width(), env.image.height(), scaled).map_err(|e| e.to_string())?;
     let cube = eq.to_cubemap(o.face).map_err(|e| e.to_string())?;
-    let decs = decompose(&cube, &crate::env::decompose::Options::quiet(&[o.k]))
-        .map_err(|e| e.to_string())?;
-    let lights: Vec<ShadeLight> = decs[0]
-        .rsls()
-        .map_err(|e| e.to_string())?
+    let decs =
+        decompose(&cube, &crate::env::decompose::Options::quiet(ks)).map_err(|e| e.to_string())?;
+    // `decompose` returns one partition per distinct K, largest first.
+    let lights = ks
         .iter()
-        .map(ShadeLight::from)
-        .collect();
+        .map(|&k| {
+            let d = decs
+                .iter()
+                .find(|d| d.k == k)
+                .ok_or_else(|| format!("no partition into {k} lights"))?;
+            let l = d.rsls().map_err(|e| e.to_string())?;
+            Ok((k, l.iter().map(ShadeLight::from).collect()))
+        })
+        .collect::<Result<Vec<_>, String>>()?;
     let refs: Vec<_> = decs.iter().collect();
     let lambert = crate::shade::fit_sat(
         &Lambert::new(1.0).map_err(|e| e.to_string())?,
@@ -111,10 +139,96 @@ pub fn build(scene: &Scene, o: &Options) -> Result<Built, String> {
             }
         }
     }
-    Ok(Built {
+    Ok(BuiltMany {
         lights,
         lambert,
         specular,
+    })
+}
+
+/// The `K` a plan tries, smallest first ([`choose_k`]).
+pub const K_CANDIDATES: [usize; 5] = [10, 30, 100, 300, 1000];
+
+/// Probe pixels per image side of [`choose_k`] (a grid of pixel centres).
+pub const K_PROBES: (u32, u32) = (16, 12);
+
+/// What [`choose_k`] chose and what it measured.
+#[derive(Clone, Debug)]
+pub struct KChoice {
+    /// The chosen `K`.
+    pub k: usize,
+    /// `(K, estimate)`: the probes' mean |difference| from the largest candidate over its
+    /// largest value.
+    pub estimates: Vec<(usize, f64)>,
+}
+
+/// The smallest `K` of [`K_CANDIDATES`] whose light decomposition alone keeps the shaded
+/// probes within half of `target` (mean |difference| over the maximum radiance, the
+/// render's measure) of the largest candidate's: the probes are a [`K_PROBES`] grid of
+/// pixel centres that meet a surface, shaded with the same visibility and BRDF SATs for
+/// every `K`, so the difference is the decomposition's alone (the error that dominates
+/// `rsl` on the built-in scenes; the other half of the target is left to visibility and
+/// the SATs). The largest candidate if none is within.
+pub fn choose_k(scene: &Scene, o: &Options, target: f64) -> Result<KChoice, String> {
+    let texels = 6 * o.face * o.face;
+    let ks: Vec<usize> = K_CANDIDATES
+        .iter()
+        .copied()
+        .filter(|&k| k <= texels)
+        .collect();
+    let many = build_many(scene, o, &ks)?;
+    let cam = scene.camera;
+    let mut cov = vec![0.0f32; o.vis_side * o.vis_side];
+    let mut probes = Vec::new();
+    for b in 0..K_PROBES.1 {
+        for a in 0..K_PROBES.0 {
+            let i = ((2 * a + 1) * cam.width / (2 * K_PROBES.0)).min(cam.width - 1);
+            let j = ((2 * b + 1) * cam.height / (2 * K_PROBES.1)).min(cam.height - 1);
+            if let Seen::Surface(p) = scene.see(&cam.centre_ray(i, j))
+                && let Some(t) = point_moments(scene, o, &p, &mut cov)
+            {
+                probes.push((p, t));
+            }
+        }
+    }
+    let shade_all = |lights: &[ShadeLight]| -> Vec<Rgb> {
+        let b = Built {
+            lights: lights.to_vec(),
+            lambert: many.lambert.clone(),
+            specular: many.specular.clone(),
+        };
+        probes
+            .iter()
+            .map(|(p, (frame, m))| shade_with(scene, &b, p, frame, m))
+            .collect()
+    };
+    let Some((_, finest)) = many.lights.last() else {
+        return Err("no candidate K fits the cube map".into());
+    };
+    let reference = shade_all(finest);
+    let max = reference
+        .iter()
+        .flat_map(|c| c.iter().copied())
+        .fold(0.0, f64::max);
+    let mut estimates = Vec::new();
+    let mut chosen = None;
+    for (k, lights) in &many.lights {
+        let img = shade_all(lights);
+        let n = (3 * img.len()).max(1) as f64;
+        let sum: f64 = img
+            .iter()
+            .zip(&reference)
+            .map(|(a, r)| (0..3).map(|c| (a[c] - r[c]).abs()).sum::<f64>())
+            .sum();
+        let e = if max > 0.0 { sum / n / max } else { 0.0 };
+        estimates.push((*k, e));
+        if chosen.is_none() && e <= 0.5 * target {
+            chosen = Some(*k);
+        }
+    }
+    Ok(KChoice {
+        k: chosen.unwrap_or(ks[ks.len() - 1]),
+        estimates,
     })
 }
 
@@ -243,16 +357,27 @@ pub fn shade_point(
     let Some((frame, moments)) = point_moments(scene, o, p, cov) else {
         return [0.0; 3];
     };
+    shade_with(scene, b, p, &frame, &moments)
+}
+
+/// [`shade_point`] with the point's frame and moment tables already built.
+fn shade_with(
+    scene: &Scene,
+    b: &Built,
+    p: &ShadingPoint,
+    frame: &Frame,
+    moments: &VisMoments,
+) -> Rgb {
     let wo = p.wo.as_vec3();
     let mat = &scene.materials[p.material];
-    let d = shade::shade_moments(&frame, wo, &b.lambert, &moments, &b.lights);
+    let d = shade::shade_moments(frame, wo, &b.lambert, moments, &b.lights);
     let parts: Vec<(Rgb, [f32; 3])> = specular_parts(mat)
         .into_iter()
         .filter_map(|(key, scale)| {
             let sat = b.specular.get(&key)?;
             Some((
                 scale,
-                shade::shade_moments(&frame, wo, sat, &moments, &b.lights),
+                shade::shade_moments(frame, wo, sat, moments, &b.lights),
             ))
         })
         .collect();
