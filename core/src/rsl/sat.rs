@@ -172,6 +172,37 @@ pub fn axis(c0: f32, c1: f32, n: usize) -> (usize, f32, usize, f32) {
     (index(i0), lo - i0, index(i1), hi - i1)
 }
 
+/// `[P, E1, E0]` between two rows `l` (lower) and `m` of corner entries, on the column
+/// pairs starting at `lo` and `hi` (`row[lo], row[lo + 1]` are `S(I0), S(I0 + 1)`, and
+/// likewise at `hi` for `I1`): each the difference of the per-row differences, in
+/// wrapping integer arithmetic ([`BoxTerms::k`]).
+#[inline(always)]
+fn row_pair_terms(l: &[i64], m: &[i64], lo: usize, hi: usize) -> [i64; 3] {
+    let p = m[hi]
+        .wrapping_sub(m[lo])
+        .wrapping_sub(l[hi].wrapping_sub(l[lo]));
+    let e1 = m[hi + 1]
+        .wrapping_sub(m[hi])
+        .wrapping_sub(l[hi + 1].wrapping_sub(l[hi]));
+    let e0 = m[lo + 1]
+        .wrapping_sub(m[lo])
+        .wrapping_sub(l[lo + 1].wrapping_sub(l[lo]));
+    [p, e1, e0]
+}
+
+/// The exact integer box between corners `(c0, r0)` and `(c1, r1)` of a grid read by
+/// [`SatView::corners`] (`g[row][col]`): `integer_box`'s four-entry formula, wrapping.
+#[inline(always)]
+pub fn corner_box<const C: usize, const R: usize>(
+    g: &[[i64; C]; R],
+    (c0, c1): (usize, usize),
+    (r0, r1): (usize, usize),
+) -> i64 {
+    g[r1][c1]
+        .wrapping_sub(g[r1][c0])
+        .wrapping_sub(g[r0][c1].wrapping_sub(g[r0][c0]))
+}
+
 /// The entries of table row `l` (rows of `w1` entries), or `None` where the range
 /// overflows `usize` (such a row is past any table; the callers read it as zeros).
 #[inline(always)]
@@ -399,19 +430,7 @@ impl<'a> SatView<'a> {
         };
         let (r0, r1, rc) = (row(j0), row(j1), row(jc));
         let (r0p, r1p, rcp) = (next(j0, b0, r0), next(j1, b1, r1), next(jc, bc, rc));
-        // `integer_terms`' [P, E1, E0] between rows l and m, on the columns (lo, hi).
-        let d = |l: [i64; 6], m: [i64; 6], lo: usize, hi: usize| -> [i64; 3] {
-            let p = m[hi]
-                .wrapping_sub(m[lo])
-                .wrapping_sub(l[hi].wrapping_sub(l[lo]));
-            let e1 = m[hi + 1]
-                .wrapping_sub(m[hi])
-                .wrapping_sub(l[hi + 1].wrapping_sub(l[hi]));
-            let e0 = m[lo + 1]
-                .wrapping_sub(m[lo])
-                .wrapping_sub(l[lo + 1].wrapping_sub(l[lo]));
-            [p, e1, e0]
-        };
+        let d = |l: [i64; 6], m: [i64; 6], lo: usize, hi: usize| row_pair_terms(&l, &m, lo, hi);
         let bx = |(l, lp, bl): ([i64; 6], [i64; 6], f32), lo: usize, a_lo: f32, hi: usize| {
             BoxTerms {
                 k: [d(l, r1, lo, hi), d(r1, r1p, lo, hi), d(l, lp, lo, hi)],
@@ -504,8 +523,7 @@ impl<'a> SatView<'a> {
     /// The entries `S(cols[c], rows[r])` in quanta, `out[r][c]` (columns clamped to the
     /// width; a row past the table reads as zeros): the corners that several
     /// [`SatView::integer_box`] queries on one grid of knots share, each read once. A box
-    /// between knots is then `out[r1][c1] − out[r1][c0] − (out[r0][c1] − out[r0][c0])`
-    /// (wrapping), the same bits as `integer_box`.
+    /// between knots is then [`corner_box`], the same bits as `integer_box`.
     #[inline(always)]
     pub fn corners<const C: usize, const R: usize>(
         &self,
@@ -591,19 +609,7 @@ impl<'a> SatView<'a> {
         } else {
             r1
         };
-        // [P, E1, E0] between rows l and m, each the difference of the per-row differences.
-        let d = |l: [i64; 4], m: [i64; 4]| -> [i64; 3] {
-            let p = m[2]
-                .wrapping_sub(m[0])
-                .wrapping_sub(l[2].wrapping_sub(l[0]));
-            let e1 = m[3]
-                .wrapping_sub(m[2])
-                .wrapping_sub(l[3].wrapping_sub(l[2]));
-            let e0 = m[1]
-                .wrapping_sub(m[0])
-                .wrapping_sub(l[1].wrapping_sub(l[0]));
-            [p, e1, e0]
-        };
+        let d = |l: [i64; 4], m: [i64; 4]| row_pair_terms(&l, &m, 0, 2);
         [d(r0, r1), d(r1, r1p), d(r0, r0p)]
     }
 

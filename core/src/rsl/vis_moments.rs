@@ -52,7 +52,7 @@ use alloc::vec::Vec;
 
 #[cfg(feature = "alloc")]
 use crate::rsl::sat::Sat;
-use crate::rsl::sat::SatView;
+use crate::rsl::sat::{SatView, corner_box};
 use crate::{Error, Vec2};
 
 /// Three exact summed-area tables of a visibility map: `V`, `u·V`, `v·V` (module docs).
@@ -238,30 +238,20 @@ impl<'a> VisMomentsView<'a> {
         let (kx, ky) = (axis_knots(a0, a1, self.n), axis_knots(b0, b1, self.n));
         let (x, y) = (kx.knots, ky.knots);
         // The nine `V` blocks share a 4 × 4 grid of corners, the three `u·V` run boxes a
-        // 2 × 4 one and the three `v·V` run boxes a 4 × 2 one: 32 reads instead of 60,
+        // 4 × 2 one and the three `v·V` run boxes a 2 × 4 one: 32 reads instead of 60,
         // the same exact integer boxes as `integer_box` on each block.
-        let bx4 = |g: &[[i64; 4]; 4], i: usize, j: usize| {
-            g[j + 1][i + 1]
-                .wrapping_sub(g[j + 1][i])
-                .wrapping_sub(g[j][i + 1].wrapping_sub(g[j][i]))
-        };
-        let gv = v.corners(x, y);
-        let bv: [[f64; 3]; 3] =
-            core::array::from_fn(|i| core::array::from_fn(|j| bx4(&gv, i, j) as f64 * v.quantum()));
-        let gx = xv.corners([x[1], x[2]], y);
-        let bx: [f64; 3] = core::array::from_fn(|j| {
-            gx[j + 1][1]
-                .wrapping_sub(gx[j + 1][0])
-                .wrapping_sub(gx[j][1].wrapping_sub(gx[j][0])) as f64
-                * xv.quantum()
+        let (gv, gx, gy) = (
+            v.corners(x, y),
+            xv.corners([x[1], x[2]], y),
+            yv.corners(x, [y[1], y[2]]),
+        );
+        let bv: [[f64; 3]; 3] = core::array::from_fn(|i| {
+            core::array::from_fn(|j| corner_box(&gv, (i, i + 1), (j, j + 1)) as f64 * v.quantum())
         });
-        let gy = yv.corners(x, [y[1], y[2]]);
-        let by: [f64; 3] = core::array::from_fn(|i| {
-            gy[1][i + 1]
-                .wrapping_sub(gy[1][i])
-                .wrapping_sub(gy[0][i + 1].wrapping_sub(gy[0][i])) as f64
-                * yv.quantum()
-        });
+        let bx: [f64; 3] =
+            core::array::from_fn(|j| corner_box(&gx, (0, 1), (j, j + 1)) as f64 * xv.quantum());
+        let by: [f64; 3] =
+            core::array::from_fn(|i| corner_box(&gy, (i, i + 1), (0, 1)) as f64 * yv.quantum());
         combine_blocks(&kx, &ky, &bv, &bx, &by, cu - hn, cv - hn, cu, cv)
     }
 }

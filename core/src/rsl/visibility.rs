@@ -22,8 +22,8 @@
 //! The map is walked block by block from the whole square: a block of texels that the
 //! bound below classifies as wholly visible, occluded or outside the disk is filled after
 //! one test, and a mixed block is split in four down to single texels (bit-identical to
-//! integrating every texel alone, tested). Each texel is integrated adaptively: a square is classified as wholly inside or outside
-//! the disk and each cap by the bound `|f(x) − f(c)| ≤ 2·|x − c|` (`1` for the disk's exact
+//! integrating every texel alone, tested). Each texel is integrated adaptively: a square
+//! is classified as wholly inside or outside the disk and each cap by the bound `|f(x) − f(c)| ≤ 2·|x − c|` (`1` for the disk's exact
 //! signed distance `1 − |p|`); a square that no boundary crosses contributes its whole area
 //! or nothing; a crossed one is split in four, down to [`LEAF_DEPTH`] levels (leaves of
 //! `1/32` texel side). At a leaf crossed by one boundary the boundary is replaced by its
@@ -60,9 +60,10 @@ pub const LEAF_DEPTH: u32 = 5;
 /// Per depth of [`coverage_into_depth`] (index `0..=LEAF_DEPTH`): the worst coverage
 /// error of one boundary texel and the relative error of the visible solid angle, as the
 /// harness asserts them against dense `f64` sampling and a polar integral for three caps
-/// (radii 0.05–0.5 rad, two of them meeting) at `n = 32`. Texels crossed by two
-/// boundaries are point-sampled 4 × 4 at their leaves, so depths 0–1 err by up to about a
-/// sixteenth there. Bounds for boundaries of that curvature, not for every configuration.
+/// (radii 0.05–0.5 rad, one crossing the horizon) at `n = 32`. Leaves crossed by two
+/// boundaries (here the horizon and a cap) are point-sampled 4 × 4, so depths 0–1 err by
+/// up to about a sixteenth there. Bounds for boundaries of that curvature, not for every
+/// configuration.
 pub const DEPTH_BOUNDS: [(f32, f32); LEAF_DEPTH as usize + 1] = [
     (0.12, 3e-3),
     (0.08, 8e-4),
@@ -275,9 +276,10 @@ pub fn coverage_into(
 
 /// [`coverage_into`] with `depth` subdivision levels below a texel instead of
 /// [`LEAF_DEPTH`] (at most [`LEAF_DEPTH`]; leaves of `2^−depth` texel side). A boundary
-/// crossing a leaf is still its tangent line, so the error per boundary texel shrinks as
-/// the cube of the leaf side; `depth = 0` tests each texel once. Errors as
-/// [`coverage_into`], and a `depth` above [`LEAF_DEPTH`].
+/// crossing a leaf is still its tangent line, so each leaf errs by its curvature times the
+/// cube of its side and a boundary texel, crossed by about `2^depth` leaves, by the
+/// square; [`DEPTH_BOUNDS`] holds the asserted figures. `depth = 0` tests each texel once.
+/// Errors as [`coverage_into`], and a `depth` above [`LEAF_DEPTH`].
 pub fn coverage_into_depth(
     caps: &[SphericalCap],
     n: usize,

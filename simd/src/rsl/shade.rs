@@ -181,20 +181,28 @@ fn box_pair_f64(
             }
         }
     }
-    let (a0, a1, b0, b1) = (widen(a0), widen(a1), widen(b0), widen(b1));
+    let f = [a0, a1, b0, b1].map(widen);
     let one = |gt: &[[i64; 8]; 16], q: [f64; 8]| -> f64x8 {
         let row = |r: usize| -> [i64x8; 4] { core::array::from_fn(|c| i64x8::new(gt[4 * r + c])) };
-        let (r0, r0p, r1, r1p) = (row(0), row(1), row(2), row(3));
-        let x = |l: [i64x8; 4], m: [i64x8; 4]| -> f64x8 {
-            let p = (m[2] - m[0]) - (l[2] - l[0]);
-            let e1 = (m[3] - m[2]) - (l[3] - l[2]);
-            let e0 = (m[1] - m[0]) - (l[1] - l[0]);
-            (p.round_float() + a1 * e1.round_float()) - a0 * e0.round_float()
-        };
-        let (xb, xt, xd) = (x(r0, r1), x(r1, r1p), x(r0, r0p));
-        ((xb + b1 * xt) - b0 * xd) * f64x8::new(q)
+        combine_lanes([row(0), row(1), row(2), row(3)], f, q)
     };
     (one(&g[0], quanta[0]), one(&g[1], quanta[1]))
+}
+
+/// `BoxTerms::combine` times the quantum, lane-wise: the staged corner rows
+/// `[J0, J0+1, J1, J1+1]` (each `[S(I0), S(I0+1), S(I1), S(I1+1)]`) and the fractions
+/// `[a0, a1, b0, b1]` of one box in each lane.
+#[inline(always)]
+fn combine_lanes(rows: [[i64x8; 4]; 4], [a0, a1, b0, b1]: [f64x8; 4], q: [f64; 8]) -> f64x8 {
+    let [r0, r0p, r1, r1p] = rows;
+    let x = |l: [i64x8; 4], m: [i64x8; 4]| -> f64x8 {
+        let p = (m[2] - m[0]) - (l[2] - l[0]);
+        let e1 = (m[3] - m[2]) - (l[3] - l[2]);
+        let e0 = (m[1] - m[0]) - (l[1] - l[0]);
+        (p.round_float() + a1 * e1.round_float()) - a0 * e0.round_float()
+    };
+    let (xb, xt, xd) = (x(r0, r1), x(r1, r1p), x(r0, r0p));
+    ((xb + b1 * xt) - b0 * xd) * f64x8::new(q)
 }
 
 /// The three boxes of the BRDF gradient, `[whole, right, top]` = `[x0, x1] × [y0, y1]`,
@@ -246,7 +254,7 @@ fn box3_pair_f64(
         }
     }
     // One box of one table: rows (first pair, last pair) and columns (lo, hi) of the
-    // staging grid, with their fractions; `box_pair_f64`'s combination.
+    // staging grid, with the fractions of its low corners.
     let one = |gt: &[[i64; 8]; 36],
                q: [f64; 8],
                (rl, rh): (usize, usize),
@@ -256,15 +264,11 @@ fn box3_pair_f64(
         let row = |r: usize| -> [i64x8; 4] {
             [cl, cl + 1, ch, ch + 1].map(|c| i64x8::new(gt[6 * r + c]))
         };
-        let (r0, r0p, r1, r1p) = (row(rl), row(rl + 1), row(rh), row(rh + 1));
-        let x = |l: [i64x8; 4], m: [i64x8; 4]| -> f64x8 {
-            let p = (m[2] - m[0]) - (l[2] - l[0]);
-            let e1 = (m[3] - m[2]) - (l[3] - l[2]);
-            let e0 = (m[1] - m[0]) - (l[1] - l[0]);
-            (p.round_float() + a1 * e1.round_float()) - fa0 * e0.round_float()
-        };
-        let (xb, xt, xd) = (x(r0, r1), x(r1, r1p), x(r0, r0p));
-        ((xb + b1 * xt) - fb0 * xd) * f64x8::new(q)
+        combine_lanes(
+            [row(rl), row(rl + 1), row(rh), row(rh + 1)],
+            [fa0, a1, fb0, b1],
+            q,
+        )
     };
     let both = |rows, cols, f| {
         (
