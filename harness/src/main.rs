@@ -79,7 +79,7 @@ enum Command {
         bounces: u32,
         /// The error the approximations plan for: mean |difference| over the maximum
         /// radiance.
-        #[arg(long, default_value_t = 0.0028)]
+        #[arg(long, default_value_t = scene::render::DEFAULT_TARGET_ERROR)]
         target_error: f64,
         /// Exposure of the PNG in EV (the PNG is srgb(radiance·2^EV)).
         #[arg(long, default_value_t = 0.0)]

@@ -59,9 +59,19 @@ impl Default for Options {
             face: 32,
             vis_side: 32,
             sat_target: 0.005,
-            vis_depth: 2,
+            vis_depth: coverage_depth_for(super::render::DEFAULT_TARGET_ERROR),
         }
     }
+}
+
+/// The coarsest coverage depth whose asserted visible-solid-angle bound
+/// ([`steradian_core::rsl::visibility::DEPTH_BOUNDS`]) is within a tenth of `target`
+/// (the render's mean |difference| over the maximum radiance); the full depth when none is.
+pub fn coverage_depth_for(target: f64) -> u32 {
+    use steradian_core::rsl::visibility::{DEPTH_BOUNDS, LEAF_DEPTH};
+    (0..=LEAF_DEPTH)
+        .find(|&d| f64::from(DEPTH_BOUNDS[d as usize].1) <= target / 10.0)
+        .unwrap_or(LEAF_DEPTH)
 }
 
 /// What the method built for a scene.
@@ -176,7 +186,11 @@ pub fn choose_k(scene: &Scene, o: &Options, target: f64) -> Result<KChoice, Stri
         .copied()
         .filter(|&k| k <= texels)
         .collect();
-    let many = build_many(scene, o, &ks)?;
+    let BuiltMany {
+        lights: by_k,
+        lambert,
+        specular,
+    } = build_many(scene, o, &ks)?;
     let cam = scene.camera;
     let mut cov = vec![0.0f32; o.vis_side * o.vis_side];
     let mut probes = Vec::new();
@@ -191,33 +205,37 @@ pub fn choose_k(scene: &Scene, o: &Options, target: f64) -> Result<KChoice, Stri
             }
         }
     }
-    let shade_all = |lights: &[ShadeLight]| -> Vec<Rgb> {
-        let b = Built {
-            lights: lights.to_vec(),
-            lambert: many.lambert.clone(),
-            specular: many.specular.clone(),
-        };
-        probes
-            .iter()
-            .map(|(p, (frame, m))| shade_with(scene, &b, p, frame, m))
-            .collect()
+    // The probes shaded with each K's lights (the SATs shared).
+    let mut b = Built {
+        lights: Vec::new(),
+        lambert,
+        specular,
     };
-    let Some((_, finest)) = many.lights.last() else {
+    let shaded: Vec<(usize, Vec<Rgb>)> = by_k
+        .into_iter()
+        .map(|(k, lights)| {
+            b.lights = lights;
+            let img = probes
+                .iter()
+                .map(|(p, (frame, m))| shade_with(scene, &b, p, frame, m))
+                .collect();
+            (k, img)
+        })
+        .collect();
+    let Some((_, reference)) = shaded.last() else {
         return Err("no candidate K fits the cube map".into());
     };
-    let reference = shade_all(finest);
     let max = reference
         .iter()
         .flat_map(|c| c.iter().copied())
         .fold(0.0, f64::max);
     let mut estimates = Vec::new();
     let mut chosen = None;
-    for (k, lights) in &many.lights {
-        let img = shade_all(lights);
+    for (k, img) in &shaded {
         let n = (3 * img.len()).max(1) as f64;
         let sum: f64 = img
             .iter()
-            .zip(&reference)
+            .zip(reference)
             .map(|(a, r)| (0..3).map(|c| (a[c] - r[c]).abs()).sum::<f64>())
             .sum();
         let e = if max > 0.0 { sum / n / max } else { 0.0 };
@@ -284,27 +302,29 @@ pub enum SpecKey {
 }
 
 /// The specular parts of a material: each SAT it needs and the RGB that scales it
-/// (Phong's and GGX's `specular`, each Lafortune lobe's `ρ`).
-pub fn specular_parts(mat: &Material) -> Vec<(SpecKey, Rgb)> {
-    match mat {
-        Material::Lambert { .. } => Vec::new(),
+/// (Phong's and GGX's `specular`, each Lafortune lobe's `ρ`), without allocating (it runs
+/// per shading point).
+pub fn specular_parts(mat: &Material) -> impl Iterator<Item = (SpecKey, Rgb)> + '_ {
+    let single = match *mat {
         Material::Phong {
             specular, exponent, ..
-        } => vec![(SpecKey::Phong(exponent.to_bits()), *specular)],
+        } => Some((SpecKey::Phong(exponent.to_bits()), specular)),
         Material::Ggx {
             specular,
             f0,
             alpha,
             ..
-        } => vec![(SpecKey::Ggx(f0.to_bits(), alpha.to_bits()), *specular)],
-        Material::Lafortune { lobes, .. } => lobes
-            .iter()
-            .map(|l| {
-                let k = SpecKey::Lafortune(l.c.to_bits(), l.cz.to_bits(), l.exponent.to_bits());
-                (k, l.rho)
-            })
-            .collect(),
-    }
+        } => Some((SpecKey::Ggx(f0.to_bits(), alpha.to_bits()), specular)),
+        _ => None,
+    };
+    let lobes = match mat {
+        Material::Lafortune { lobes, .. } => lobes.as_slice(),
+        _ => &[],
+    };
+    single.into_iter().chain(lobes.iter().map(|l| {
+        let k = SpecKey::Lafortune(l.c.to_bits(), l.cz.to_bits(), l.exponent.to_bits());
+        (k, l.rho)
+    }))
 }
 
 /// The BRDF SAT of one specular part, fitted to `target` over the decompositions.
@@ -335,7 +355,7 @@ fn fit_part(
 
 /// The reflected radiance from the diffuse integral `d` and the integral of each specular
 /// part with its RGB scale ([`shade::shade_moments`] with the Lambert SAT and each part's).
-fn combine(mat: &Material, d: [f32; 3], parts: &[(Rgb, [f32; 3])]) -> Rgb {
+fn combine(mat: &Material, d: [f32; 3], parts: impl IntoIterator<Item = (Rgb, [f32; 3])>) -> Rgb {
     let diffuse = mat.diffuse();
     let mut out: Rgb = core::array::from_fn(|c| diffuse[c] * d[c] as f64);
     for (scale, s) in parts {
@@ -371,23 +391,65 @@ fn shade_with(
     let wo = p.wo.as_vec3();
     let mat = &scene.materials[p.material];
     let d = shade::shade_moments(frame, wo, &b.lambert, moments, &b.lights);
-    let parts: Vec<(Rgb, [f32; 3])> = specular_parts(mat)
-        .into_iter()
-        .filter_map(|(key, scale)| {
-            let sat = b.specular.get(&key)?;
-            Some((
-                scale,
-                shade::shade_moments(frame, wo, sat, moments, &b.lights),
-            ))
+    let parts = specular_parts(mat).filter_map(|(key, scale)| {
+        let sat = b.specular.get(&key)?;
+        Some((
+            scale,
+            shade::shade_moments(frame, wo, sat, moments, &b.lights),
+        ))
+    });
+    combine(mat, d, parts)
+}
+
+/// A kernel run over a set of points with one BRDF SAT: `None` the Lambert SAT, `Some(key)`
+/// a specular part's; `sel` indexes the caller's points; one integral per selected point.
+type PartBatch<'a> = dyn FnMut(Option<SpecKey>, &[usize]) -> Result<Vec<[f32; 3]>, String> + 'a;
+
+/// The radiance of points shaded part by part, the batched twin of [`shade_with`]:
+/// `materials[q]` is point `q`'s material; `batch` shades all points with the Lambert SAT,
+/// then, per specular part of [`Built::specular`], the points whose material has it; each
+/// point's integrals are then combined with its diffuse RGB and the parts' scales.
+fn shade_by_part(
+    scene: &Scene,
+    built: &Built,
+    materials: &[usize],
+    batch: &mut PartBatch<'_>,
+) -> Result<Vec<Rgb>, String> {
+    let all: Vec<usize> = (0..materials.len()).collect();
+    let d = batch(None, &all)?;
+    let mut parts: Vec<Vec<(Rgb, [f32; 3])>> = vec![Vec::new(); materials.len()];
+    for key in built.specular.keys() {
+        let (sel, scales): (Vec<usize>, Vec<Rgb>) = all
+            .iter()
+            .filter_map(|&q| {
+                specular_parts(&scene.materials[materials[q]])
+                    .find(|(pk, _)| pk == key)
+                    .map(|(_, scale)| (q, scale))
+            })
+            .unzip();
+        if sel.is_empty() {
+            continue;
+        }
+        let s = batch(Some(*key), &sel)?;
+        for ((&q, v), scale) in sel.iter().zip(s).zip(scales) {
+            parts[q].push((scale, v));
+        }
+    }
+    Ok((0..materials.len())
+        .map(|q| {
+            combine(
+                &scene.materials[materials[q]],
+                d[q],
+                parts[q].iter().copied(),
+            )
         })
-        .collect();
-    combine(mat, d, &parts)
+        .collect())
 }
 
 /// [`render_built`] through the SIMD moments kernel: per row, each surface point's moment
 /// tables as in [`shade_point`], then eight points at a time through
 /// [`steradian_simd::rsl::shade::shade_moments_batch`] with the Lambert SAT and with each
-/// Phong SAT its points need. Each pixel is within the kernel's
+/// specular part's SAT ([`shade_by_part`]). Each pixel is within the kernel's
 /// [`steradian_simd::rsl::shade::MOMENTS_REL_TOL`] of [`render_built`] (relative to the
 /// pixel's largest channel; the harness test asserts it). `Err` for a BRDF SAT the SIMD
 /// kernel does not take (anisotropic).
@@ -433,49 +495,36 @@ pub fn render_built_simd(
                     }
                 }
             }
-            let input = |sel: &[usize]| -> Vec<MomentsInput<'_>> {
-                sel.iter()
-                    .map(|&k| MomentsInput {
-                        frame: pts[k].2,
-                        wo: pts[k].1.wo.as_vec3(),
-                        vis: pts[k].3.view(),
-                    })
-                    .collect()
-            };
-            let all: Vec<usize> = (0..pts.len()).collect();
-            let mut d = vec![[0.0f32; 3]; pts.len()];
-            if !shade_moments_batch(&input(&all), &lambert, &built.lights, &mut d) {
-                return Err("visibility tables of different sizes".to_string());
-            }
-            let mut s: Vec<Vec<(Rgb, [f32; 3])>> = vec![Vec::new(); pts.len()];
-            for (key, (views, s_max)) in &specular_views {
-                // The points with this part, and its scale at each.
-                let (sel, scales): (Vec<usize>, Vec<Rgb>) = all
-                    .iter()
-                    .filter_map(|&k| {
-                        specular_parts(&scene.materials[pts[k].1.material])
-                            .into_iter()
-                            .find(|(pk, _)| pk == key)
-                            .map(|(_, scale)| (k, scale))
-                    })
-                    .unzip();
-                if sel.is_empty() {
-                    continue;
-                }
-                let tables = IsoBrdfTables {
-                    tables: views,
-                    s_max: *s_max,
+            let materials: Vec<usize> = pts.iter().map(|p| p.1.material).collect();
+            let mut batch = |key: Option<SpecKey>, sel: &[usize]| {
+                let tables = match key {
+                    None => lambert,
+                    Some(k) => {
+                        let (views, s_max) = &specular_views[&k];
+                        IsoBrdfTables {
+                            tables: views,
+                            s_max: *s_max,
+                        }
+                    }
                 };
+                let input: Vec<MomentsInput<'_>> = sel
+                    .iter()
+                    .map(|&q| MomentsInput {
+                        frame: pts[q].2,
+                        wo: pts[q].1.wo.as_vec3(),
+                        vis: pts[q].3.view(),
+                    })
+                    .collect();
                 let mut out = vec![[0.0f32; 3]; sel.len()];
-                if !shade_moments_batch(&input(&sel), &tables, &built.lights, &mut out) {
-                    return Err("visibility tables of different sizes".to_string());
+                if shade_moments_batch(&input, &tables, &built.lights, &mut out) {
+                    Ok(out)
+                } else {
+                    Err("visibility tables of different sizes".to_string())
                 }
-                for ((k, v), scale) in sel.into_iter().zip(out).zip(scales) {
-                    s[k].push((scale, v));
-                }
-            }
-            for (k, (i, p, _, _)) in pts.iter().enumerate() {
-                row[*i] = combine(&scene.materials[p.material], d[k], &s[k]);
+            };
+            let shaded = shade_by_part(scene, built, &materials, &mut batch)?;
+            for ((i, _, _, _), v) in pts.iter().zip(shaded) {
+                row[*i] = v;
             }
             bar.inc(1);
             Ok(row)
@@ -510,8 +559,8 @@ pub const GPU_BATCH: usize = 4096;
 
 /// [`render_built`] on the wgpu backend: the surface points' moment tables as in
 /// [`shade_point`] (CPU, in parallel), then `wgsl::SHADE_MOMENTS` for the Lambert SAT and
-/// each specular part's SAT ([`crate::shade::shade_moments_gpu_at`]), [`GPU_BATCH`] points
-/// at a time. Each pixel is within `steradian_core::wgsl::SHADE_MOMENTS_REL_TOL` of
+/// each specular part's SAT ([`shade_by_part`], [`crate::shade::shade_moments_gpu_at`]),
+/// [`GPU_BATCH`] points at a time. Each pixel is within `steradian_core::wgsl::SHADE_MOMENTS_REL_TOL` of
 /// [`render_built`] (relative to the pixel's largest channel; the GPU scene test asserts
 /// it). `Err` for a device error or a BRDF SAT the kernel does not take (anisotropic).
 pub fn render_built_gpu(
@@ -538,22 +587,8 @@ pub fn render_built_gpu(
             }
         }
     }
-    let run = |gpu: &mut crate::backend::gpu::Gpu,
-               pts: &[ShadePoint],
-               sat: &BrdfSat,
-               ms: &[&VisMoments]| {
-        shade_moments_gpu_at(
-            gpu,
-            pts,
-            sat,
-            ms,
-            &built.lights,
-            GPU_MOMENTS_MAX_TABLE_BYTES,
-        )
-        .map_err(|e| e.to_string())
-    };
-    for batch in queue.chunks(GPU_BATCH) {
-        let tables: Vec<Option<(Frame, VisMoments)>> = batch
+    for chunk in queue.chunks(GPU_BATCH) {
+        let tables: Vec<Option<(Frame, VisMoments)>> = chunk
             .par_iter()
             .map_init(
                 || vec![0.0f32; o.vis_side * o.vis_side],
@@ -564,7 +599,7 @@ pub fn render_built_gpu(
         let mut px = Vec::new();
         let mut pts = Vec::new();
         let mut ms = Vec::new();
-        for ((k, p), t) in batch.iter().zip(tables) {
+        for ((k, p), t) in chunk.iter().zip(tables) {
             if let Some((frame, m)) = t {
                 px.push((*k, p.material));
                 pts.push(ShadePoint {
@@ -576,32 +611,29 @@ pub fn render_built_gpu(
                 ms.push(m);
             }
         }
-        let all: Vec<&VisMoments> = ms.iter().collect();
-        let d = run(gpu, &pts, &built.lambert, &all)?;
-        let mut parts: Vec<Vec<(Rgb, [f32; 3])>> = vec![Vec::new(); pts.len()];
-        for (key, sat) in &built.specular {
-            let (sel, scales): (Vec<usize>, Vec<Rgb>) = (0..pts.len())
-                .filter_map(|q| {
-                    specular_parts(&scene.materials[px[q].1])
-                        .into_iter()
-                        .find(|(pk, _)| pk == key)
-                        .map(|(_, scale)| (q, scale))
-                })
-                .unzip();
-            if sel.is_empty() {
-                continue;
-            }
+        let materials: Vec<usize> = px.iter().map(|&(_, mi)| mi).collect();
+        let mut batch = |key: Option<SpecKey>, sel: &[usize]| {
+            let sat = match key {
+                None => &built.lambert,
+                Some(k) => &built.specular[&k],
+            };
             let sub_pts: Vec<ShadePoint> = sel.iter().map(|&q| pts[q].clone()).collect();
             let sub_ms: Vec<&VisMoments> = sel.iter().map(|&q| &ms[q]).collect();
-            let s = run(gpu, &sub_pts, sat, &sub_ms)?;
-            for ((&q, v), scale) in sel.iter().zip(s).zip(scales) {
-                parts[q].push((scale, v));
-            }
+            shade_moments_gpu_at(
+                gpu,
+                &sub_pts,
+                sat,
+                &sub_ms,
+                &built.lights,
+                GPU_MOMENTS_MAX_TABLE_BYTES,
+            )
+            .map_err(|e| e.to_string())
+        };
+        let shaded = shade_by_part(scene, built, &materials, &mut batch)?;
+        for (&(k, _), v) in px.iter().zip(shaded) {
+            img.data[k] = v;
         }
-        for (q, &(k, mi)) in px.iter().enumerate() {
-            img.data[k] = combine(&scene.materials[mi], d[q], &parts[q]);
-        }
-        bar.inc(batch.len() as u64);
+        bar.inc(chunk.len() as u64);
     }
     bar.set_position((w * h) as u64);
     Ok(img)
