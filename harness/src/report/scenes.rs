@@ -5,9 +5,9 @@
 //!
 //! Per scene of [`SCENES`] (at [`WIDTH`] columns): the reference is the path tracer at
 //! [`REFERENCE_SPP`] samples per pixel ([`ENVIRONMENT_REFERENCE_SPP`] for `environment`,
-//! whose reference is the noisiest per sample) (direct light for `lobes` and `cluster`, one bounce
-//! for `room`); the path tracer's curve is the same tracer with other seeds at 1–256
-//! samples. The `lobes` method's curve is its pruning threshold, with the L2 cap fit and
+//! whose reference is the noisiest per sample), direct light for `lobes` and `cluster` and
+//! one bounce for `room`; the path tracer's curve is the same tracer with other seeds at
+//! [`PATH_SPP`] samples. The `lobes` method's curve is its pruning threshold, with the L2 cap fit and
 //! one lobe per occluder (instead of the default energy-preserving fit and quadtree mask)
 //! beside it; the `hvl` method's curve is its HVL count, with the paper's choice of no
 //! HVL visibility and the direct light alone beside it; the `rsl` method's is its number
@@ -36,8 +36,8 @@ use crate::scene::{Scene, Seen, hvl, lobes, path, rsl};
 pub const WIDTH: u32 = 96;
 /// Samples per pixel of the reference.
 pub const REFERENCE_SPP: u32 = 512;
-/// Samples per pixel of the `environment` reference: at 512 its noise (about 1.2 % of the
-/// maximum radiance) hid the `rsl` method's error from K = 100 on.
+/// Samples per pixel of the `environment` reference: at [`REFERENCE_SPP`] its noise
+/// (`reference_noise_over_max` in the report) was as large as the `rsl` method's error.
 pub const ENVIRONMENT_REFERENCE_SPP: u32 = 4096;
 
 /// The reference's samples per pixel for a scene.
@@ -48,8 +48,8 @@ fn reference_spp(name: &str) -> u32 {
         REFERENCE_SPP
     }
 }
-/// The path tracer's own curve.
-const PATH_SPP: &[u32] = &[1, 2, 4, 8, 16, 64, 256];
+/// Samples per pixel of the path tracer's own curve.
+pub const PATH_SPP: &[u32] = &[1, 2, 4, 8, 16, 64, 256];
 /// Pruning thresholds of the `lobes` curve.
 const THRESHOLDS: &[f32] = &[0.0, 1e-4, 1e-3, 1e-2, 5e-2];
 /// Reflective-shadow-map face sides of the `hvl` curve.
@@ -149,6 +149,9 @@ struct Setting<'a> {
     default: bool,
     /// Seconds of precomputation done before the timed render, if any.
     build_seconds: Option<f64>,
+    /// The kernel this setting's one-core throughput is reported under (`per_core[]`),
+    /// if it is measured.
+    per_core: Option<&'static str>,
 }
 
 fn lobes_settings(scene: &Scene) -> (Vec<Setting<'_>>, Vec<Setting<'_>>) {
@@ -162,6 +165,7 @@ fn lobes_settings(scene: &Scene) -> (Vec<Setting<'_>>, Vec<Setting<'_>>) {
         }),
         default,
         build_seconds: None,
+        per_core: default.then_some("scalar"),
     };
     let curve = THRESHOLDS
         .iter()
@@ -201,6 +205,7 @@ fn hvl_settings(scene: &Scene) -> (Vec<Setting<'_>>, Vec<Setting<'_>>) {
         render: Box::new(move || (hvl::render(scene, &o, &ProgressBar::hidden()).0, None)),
         default,
         build_seconds: None,
+        per_core: default.then_some("scalar"),
     };
     let curve = HVL_SIDES
         .iter()
@@ -234,64 +239,68 @@ fn hvl_settings(scene: &Scene) -> (Vec<Setting<'_>>, Vec<Setting<'_>>) {
             }),
             default: false,
             build_seconds: None,
+            per_core: None,
         },
     ];
     (curve, variants)
 }
 
-/// The label suffix of a setting shaded by a SIMD kernel.
-const SIMD_LABEL: &str = ", SIMD kernel";
-
-/// The label suffix of a setting shaded on the wgpu backend.
-const WGPU_LABEL: &str = ", wgpu";
+/// How an `rsl` setting shades: its label suffix and its `per_core[]` kernel name.
+#[derive(Clone, Copy, PartialEq)]
+enum RslKernel {
+    Scalar,
+    Simd,
+    Wgpu,
+}
 
 fn rsl_settings<'a>(
     scene: &'a Scene,
     gpu: Option<&'a std::sync::Mutex<crate::backend::gpu::Gpu>>,
 ) -> (Vec<Setting<'a>>, Vec<Setting<'a>>) {
     let d = rsl::Options::default();
-    let setting = |k: usize, simd: bool| {
+    let setting = |k: usize, kernel: RslKernel| {
         let o = rsl::Options { k, ..d };
         let (built, build_seconds) = timed(|| rsl::build(scene, &o));
-        let blank = || Image::new(scene.camera.width as usize, scene.camera.height as usize);
+        let (suffix, name) = match kernel {
+            RslKernel::Scalar => ("", "scalar"),
+            RslKernel::Simd => (", SIMD kernel", "simd"),
+            RslKernel::Wgpu => (", wgpu", "wgpu"),
+        };
+        let default = k == d.k && kernel == RslKernel::Scalar;
         Setting {
-            label: format!("K = {k}{}", if simd { SIMD_LABEL } else { "" }),
+            label: format!("K = {k}{suffix}"),
             render: Box::new(move || {
                 let hidden = ProgressBar::hidden();
-                let img = match &built {
-                    Ok(b) if simd => {
-                        rsl::render_built_simd(scene, b, &o, &hidden).unwrap_or_else(|_| blank())
-                    }
-                    Ok(b) => rsl::render_built(scene, b, &o, &hidden),
-                    Err(_) => blank(),
-                };
-                (img, None)
-            }),
-            default: k == d.k && !simd,
-            build_seconds: Some(build_seconds),
-        }
-    };
-    let curve = RSL_KS.iter().map(|&k| setting(k, false)).collect();
-    let mut variants = vec![setting(d.k, true)];
-    if let Some(gpu) = gpu {
-        let (built, build_seconds) = timed(|| rsl::build(scene, &d));
-        variants.push(Setting {
-            label: format!("K = {}{WGPU_LABEL}", d.k),
-            render: Box::new(move || {
+                let img = built
+                    .as_ref()
+                    .map_err(Clone::clone)
+                    .and_then(|b| match kernel {
+                        RslKernel::Scalar => Ok(rsl::render_built(scene, b, &o, &hidden)),
+                        RslKernel::Simd => rsl::render_built_simd(scene, b, &o, &hidden),
+                        RslKernel::Wgpu => {
+                            let mut g = gpu
+                                .ok_or("no adapter")?
+                                .lock()
+                                .map_err(|_| "adapter lock poisoned")?;
+                            rsl::render_built_gpu(scene, b, &o, &mut g, &hidden)
+                        }
+                    });
                 let blank =
                     || Image::new(scene.camera.width as usize, scene.camera.height as usize);
-                let img = match (&built, gpu.lock()) {
-                    (Ok(b), Ok(mut g)) => {
-                        rsl::render_built_gpu(scene, b, &d, &mut g, &ProgressBar::hidden())
-                            .unwrap_or_else(|_| blank())
-                    }
-                    _ => blank(),
-                };
-                (img, None)
+                (img.unwrap_or_else(|_| blank()), None)
             }),
-            default: false,
+            default,
             build_seconds: Some(build_seconds),
-        });
+            per_core: (default || kernel != RslKernel::Scalar).then_some(name),
+        }
+    };
+    let curve = RSL_KS
+        .iter()
+        .map(|&k| setting(k, RslKernel::Scalar))
+        .collect();
+    let mut variants = vec![setting(d.k, RslKernel::Simd)];
+    if gpu.is_some() {
+        variants.push(setting(d.k, RslKernel::Wgpu));
     }
     (curve, variants)
 }
@@ -386,20 +395,8 @@ fn measure_scene(
         .count();
     let pool = rayon::ThreadPoolBuilder::new().num_threads(1).build()?;
     let mut per_core = Vec::new();
-    for (kernel, st) in curve_settings
-        .iter()
-        .filter(|st| st.default)
-        .map(|st| ("scalar", st))
-        .chain(variant_settings.iter().filter_map(|st| {
-            if st.label.ends_with(SIMD_LABEL) {
-                Some(("simd", st))
-            } else if st.label.ends_with(WGPU_LABEL) {
-                Some(("wgpu", st))
-            } else {
-                None
-            }
-        }))
-    {
+    for st in curve_settings.iter().chain(&variant_settings) {
+        let Some(kernel) = st.per_core else { continue };
         let s = (0..2)
             .map(|_| timed(|| pool.install(|| (st.render)())).1)
             .fold(f64::INFINITY, f64::min);
@@ -522,7 +519,7 @@ pub fn section(opts: &Options) -> Result<Section, Box<dyn Error>> {
             .collect();
         writeln!(
             summary,
-            "  {} ({}, {} bounce(s)): {:.2e} of max radiance, RMSE {:.4}, in {:.1} ms ({}); path tracer {:.2e} at 1 spp, {:.2e} at 256 spp; reference noise {:.1e}; equal-error cost ratio {:.1}×",
+            "  {} ({}, {} bounce(s)): {:.2e} of max radiance, RMSE {:.4}, in {:.1} ms ({}); path tracer {:.2e} at {} spp, {:.2e} at {} spp; reference noise {:.1e}; equal-error cost ratio {:.1}×",
             r.name,
             r.method,
             r.bounces,
@@ -535,7 +532,9 @@ pub fn section(opts: &Options) -> Result<Section, Box<dyn Error>> {
                 variants.join("; ")
             },
             r.path[0].metrics.mean_abs_over_max,
+            PATH_SPP[0],
             r.path[r.path.len() - 1].metrics.mean_abs_over_max,
+            PATH_SPP[PATH_SPP.len() - 1],
             d.metrics.reference_noise_over_max,
             r.equal_error_ratio
         )?;
