@@ -512,96 +512,110 @@ fn noise_corrected_rel_l2_removes_the_reference_noise() {
     assert!((noisy.rel_l2_noise_corrected / exact.rel_l2 - 1.0).abs() < 0.1);
 }
 
+/// An environment-lit scene with every specular kind `rsl` carries: two GGX spheres, a
+/// two-lobe Lafortune sphere and a Phong sphere over a Lambert floor, under `city.exr`.
+const MIXED: &str = r#"{
+  "camera": {"eye": [0, -5, 1.6], "target": [0, 0, 0.6], "up": [0, 0, 1], "fov_y": 40, "width": 40, "height": 30},
+  "materials": {
+    "floor": {"lambert": {"albedo": [0.6, 0.6, 0.6]}},
+    "metal": {"ggx": {"diffuse": [0.05, 0.05, 0.05], "specular": [0.9, 0.7, 0.4], "f0": 0.9, "roughness": 0.25}},
+    "plastic": {"ggx": {"diffuse": [0.5, 0.1, 0.1], "specular": [0.5, 0.5, 0.5], "f0": 0.04, "roughness": 0.1}},
+    "gold": {"lafortune": {"diffuse": [0.25, 0.18, 0.05], "lobes": [{"c": [-1, -1, 1], "exponent": 30, "rho": [0.6, 0.45, 0.15]}, {"c": [-0.5, -0.5, 0.9], "exponent": 5, "rho": [0.3, 0.2, 0.1]}]}},
+    "glossy": {"phong": {"diffuse": [0.3, 0.3, 0.35], "specular": [0.5, 0.5, 0.5], "exponent": 60}}
+  },
+  "spheres": [
+    {"center": [-0.5, 0, 0.6], "radius": 0.6, "material": "metal"},
+    {"center": [0.9, -0.3, 0.4], "radius": 0.4, "material": "plastic"},
+    {"center": [0.6, 1.0, 0.5], "radius": 0.5, "material": "gold"},
+    {"center": [-1.4, 1.2, 0.4], "radius": 0.4, "material": "glossy"}
+  ],
+  "planes": [{"point": [0, 0, 0], "normal": [0, 0, 1], "material": "floor"}],
+  "lights": [{"environment": {"file": "city.exr", "scale": 1.0}}]
+}"#;
+
+/// [`MIXED`] (or a variant of its text), its environment read from `scenes/`.
+fn mixed(json: &str) -> Result<Scene, String> {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenes");
+    Scene::from_json(json, &dir).map_err(|e| e.0)
+}
+
+/// Asserts that every pixel of `b` is within `tol` of `a`'s, relative to the pixel's
+/// largest channel in `a` (so a black pixel must stay black); returns the pixels with
+/// light and the worst relative difference.
+fn assert_pixels_close(a: &Image, b: &Image, tol: f64) -> (usize, f64) {
+    let (mut lit, mut worst) = (0, 0.0f64);
+    for (p, q) in a.data.iter().zip(&b.data) {
+        let m = p.iter().cloned().fold(0.0, f64::max);
+        lit += (m > 0.0) as usize;
+        for c in 0..3 {
+            let e = (p[c] - q[c]).abs() / m.max(1e-30);
+            assert!(e <= tol, "{p:?} vs {q:?}");
+            worst = worst.max(e);
+        }
+    }
+    (lit, worst)
+}
+
 /// The `rsl` method's SIMD path gives every pixel of the scalar path within the moments
-/// kernel's tolerance (relative to the pixel's largest channel), on the glossy and the
-/// diffuse objects of the `environment` scene, and the same pixels as the scalar path.
+/// kernel's tolerance (relative to the pixel's largest channel), on `environment` (Phong
+/// and Lambert) and on [`MIXED`] (GGX and Lafortune too).
 #[test]
 fn rsl_simd_path_matches_the_scalar_path_pixel_by_pixel() {
     use steradian_harness::scene::rsl;
     use steradian_simd::rsl::shade::MOMENTS_REL_TOL;
-    let mut scene = Scene::load("builtin:environment").unwrap();
-    scene.camera = scene.camera.resized(40).unwrap();
-    let o = rsl::Options::default();
-    let built = rsl::build(&scene, &o).unwrap();
-    let hidden = ProgressBar::hidden();
-    let scalar = rsl::render_built(&scene, &built, &o, &hidden);
-    let simd = rsl::render_built_simd(&scene, &built, &o, &hidden).unwrap();
-    let mut lit = 0;
-    for (a, b) in scalar.data.iter().zip(&simd.data) {
-        let m = a.iter().cloned().fold(0.0, f64::max);
-        lit += (m > 0.0) as usize;
-        for c in 0..3 {
-            assert!(
-                (a[c] - b[c]).abs() <= MOMENTS_REL_TOL as f64 * m.max(1e-30),
-                "{a:?} vs {b:?}"
-            );
-        }
+    let mut env = Scene::load("builtin:environment").unwrap();
+    env.camera = env.camera.resized(40).unwrap();
+    for (s, min_lit) in [(env, 1000), (mixed(MIXED).unwrap(), 800)] {
+        let o = rsl::Options::default();
+        let built = rsl::build(&s, &o).unwrap();
+        let hidden = ProgressBar::hidden();
+        let scalar = rsl::render_built(&s, &built, &o, &hidden);
+        let simd = rsl::render_built_simd(&s, &built, &o, &hidden).unwrap();
+        let (lit, _) = assert_pixels_close(&scalar, &simd, MOMENTS_REL_TOL as f64);
+        assert!(lit > min_lit, "{lit}");
     }
-    assert!(lit > 1000, "{lit}");
 }
 
 /// GGX materials (core's `Ggx` with an RGB tint) and Lafortune lobes under an
-/// environment: the path tracer samples them (the material unit tests check its density
-/// and core's values), the `rsl` method carries them through a BRDF SAT per GGX `(f0, α)`
-/// and per Lafortune lobe and stays within 1.5 % noise-corrected relative L2 of the path
-/// tracer (2048 samples; the test prints the measured figure), and its SIMD path matches
-/// its scalar path per pixel within the moments kernel's tolerance;
-/// and the lobe methods refuse them by name; a roughness out of range names its field.
+/// environment ([`MIXED`]): the path tracer samples them (the material unit tests check
+/// its density and core's values), the `rsl` method carries them through a BRDF SAT per
+/// GGX `(f0, α)` and per Lafortune lobe and stays within 1.5 % noise-corrected relative L2
+/// of the path tracer (2048 samples; the test prints the measured figure), the lobe
+/// methods refuse GGX by name, and a roughness out of range names its field.
 #[test]
 fn ggx_and_lafortune_materials_in_path_and_rsl() {
     use steradian_harness::scene::render::{self, Method};
     use steradian_harness::scene::rsl;
-    let json = r#"{
-      "camera": {"eye": [0, -5, 1.6], "target": [0, 0, 0.6], "up": [0, 0, 1], "fov_y": 40, "width": 32, "height": 24},
-      "materials": {
-        "floor": {"lambert": {"albedo": [0.6, 0.6, 0.6]}},
-        "metal": {"ggx": {"diffuse": [0.05, 0.05, 0.05], "specular": [0.9, 0.7, 0.4], "f0": 0.9, "roughness": 0.25}},
-        "plastic": {"ggx": {"diffuse": [0.5, 0.1, 0.1], "specular": [0.5, 0.5, 0.5], "f0": 0.04, "roughness": 0.1}},
-        "gold": {"lafortune": {"diffuse": [0.25, 0.18, 0.05], "lobes": [{"c": [-1, -1, 1], "exponent": 30, "rho": [0.6, 0.45, 0.15]}, {"c": [-0.5, -0.5, 0.9], "exponent": 5, "rho": [0.3, 0.2, 0.1]}]}}
-      },
-      "spheres": [
-        {"center": [-0.5, 0, 0.6], "radius": 0.6, "material": "metal"},
-        {"center": [0.9, -0.3, 0.4], "radius": 0.4, "material": "plastic"},
-        {"center": [0.6, 1.0, 0.5], "radius": 0.5, "material": "gold"}
-      ],
-      "planes": [{"point": [0, 0, 0], "normal": [0, 0, 1], "material": "floor"}],
-      "lights": [{"environment": {"file": "city.exr", "scale": 1.0}}]
-    }"#;
-    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenes");
-    let s = Scene::from_json(json, &dir).unwrap();
+    let small = MIXED.replace(
+        r#""width": 40, "height": 30"#,
+        r#""width": 32, "height": 24"#,
+    );
+    let s = mixed(&small).unwrap();
     let settings = path::Settings {
         spp: 2048,
         bounces: 0,
         seed: 1,
     };
     let reference = path::render(&s, &settings, &ProgressBar::hidden());
-    let img = rsl::render(&s, &rsl::Options::default(), &ProgressBar::hidden()).unwrap();
-    let class = metrics::classify(&s);
-    let m = metrics::compare(&class, &img, &reference.image, Some(&reference.stderr), 0.0).unwrap();
-    eprintln!("ggx rsl {m:?}");
-    assert!(m.rel_l2_noise_corrected < 0.015, "{m:?}");
-    assert!(m.shaded_pixels > 300);
     let o = rsl::Options::default();
     let built = rsl::build(&s, &o).unwrap();
     assert_eq!(
         built.specular.len(),
-        4,
-        "two GGX parts and two Lafortune lobes"
+        5,
+        "two GGX parts, two Lafortune lobes and a Phong exponent"
     );
-    let simd = rsl::render_built_simd(&s, &built, &o, &ProgressBar::hidden()).unwrap();
-    for (a, b) in img.data.iter().zip(&simd.data) {
-        let mx = a.iter().cloned().fold(0.0, f64::max);
-        for c in 0..3 {
-            let tol = steradian_simd::rsl::shade::MOMENTS_REL_TOL as f64 * mx.max(1e-30);
-            assert!((a[c] - b[c]).abs() <= tol, "{a:?} vs {b:?}");
-        }
-    }
+    let img = rsl::render_built(&s, &built, &o, &ProgressBar::hidden());
+    let class = metrics::classify(&s);
+    let m = metrics::compare(&class, &img, &reference.image, Some(&reference.stderr), 0.0).unwrap();
+    eprintln!("mixed rsl {m:?}");
+    assert!(m.rel_l2_noise_corrected < 0.015, "{m:?}");
+    assert!(m.shaded_pixels > 300);
     // The lobe methods have no cosine-lobe form of GGX.
-    let lit = json.replace(
+    let lit = MIXED.replace(
         r#"{"environment": {"file": "city.exr", "scale": 1.0}}"#,
         r#"{"sphere": {"center": [2, -1, 4], "radius": 0.5, "radiance": [20, 20, 20]}}"#,
     );
-    let s = Scene::from_json(&lit, &dir).unwrap();
+    let s = mixed(&lit).unwrap();
     for method in [Method::Lobes, Method::Hvl] {
         let o = render::Options {
             method,
@@ -610,8 +624,8 @@ fn ggx_and_lafortune_materials_in_path_and_rsl() {
         let e = render::plan(&s, &o).err().unwrap();
         assert!(e.contains("\"metal\" is GGX"), "{e}");
     }
-    let bad = json.replace(r#""roughness": 0.25"#, r#""roughness": 0"#);
-    let e = Scene::from_json(&bad, &dir).err().unwrap().0;
+    let bad = MIXED.replace(r#""roughness": 0.25"#, r#""roughness": 0"#);
+    let e = mixed(&bad).err().unwrap();
     assert!(
         e.contains("materials.metal.ggx.roughness: must be in [0.001, 1]"),
         "{e}"
@@ -620,7 +634,7 @@ fn ggx_and_lafortune_materials_in_path_and_rsl() {
 
 /// The `rsl` method's wgpu path (`render_built_gpu`: `wgsl::SHADE_MOMENTS` per batch)
 /// gives every pixel of the scalar path within `SHADE_MOMENTS_REL_TOL` of the pixel's
-/// largest channel, on a scene with Phong, GGX and Lafortune parts.
+/// largest channel, on [`MIXED`] (Phong, GGX and Lafortune parts).
 #[test]
 fn rsl_gpu_path_matches_the_scalar_path_pixel_by_pixel() {
     use crate::common::gpu as gpu_common;
@@ -629,43 +643,17 @@ fn rsl_gpu_path_matches_the_scalar_path_pixel_by_pixel() {
     let Some(mut gpu) = gpu_common::gpu() else {
         return;
     };
-    let json = r#"{
-      "camera": {"eye": [0, -5, 1.6], "target": [0, 0, 0.6], "up": [0, 0, 1], "fov_y": 40, "width": 40, "height": 30},
-      "materials": {
-        "floor": {"lambert": {"albedo": [0.6, 0.6, 0.6]}},
-        "glossy": {"phong": {"diffuse": [0.3, 0.3, 0.35], "specular": [0.5, 0.5, 0.5], "exponent": 60}},
-        "metal": {"ggx": {"diffuse": [0.05, 0.05, 0.05], "specular": [0.9, 0.7, 0.4], "f0": 0.9, "roughness": 0.25}},
-        "gold": {"lafortune": {"diffuse": [0.25, 0.18, 0.05], "lobes": [{"c": [-1, -1, 1], "exponent": 30, "rho": [0.6, 0.45, 0.15]}]}}
-      },
-      "spheres": [
-        {"center": [-0.9, 0, 0.6], "radius": 0.6, "material": "metal"},
-        {"center": [0.7, -0.3, 0.5], "radius": 0.5, "material": "glossy"},
-        {"center": [0.4, 1.2, 0.5], "radius": 0.5, "material": "gold"}
-      ],
-      "planes": [{"point": [0, 0, 0], "normal": [0, 0, 1], "material": "floor"}],
-      "lights": [{"environment": {"file": "city.exr", "scale": 1.0}}]
-    }"#;
-    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenes");
-    let s = Scene::from_json(json, &dir).unwrap();
+    let s = mixed(MIXED).unwrap();
     let o = rsl::Options::default();
     let built = rsl::build(&s, &o).unwrap();
     let hidden = ProgressBar::hidden();
     let scalar = rsl::render_built(&s, &built, &o, &hidden);
     let on_gpu = rsl::render_built_gpu(&s, &built, &o, &mut gpu, &hidden).unwrap();
-    let (mut lit, mut worst) = (0, 0.0f64);
-    for (a, b) in scalar.data.iter().zip(&on_gpu.data) {
-        let m = a.iter().cloned().fold(0.0, f64::max);
-        lit += (m > 0.0) as usize;
-        for c in 0..3 {
-            let e = (a[c] - b[c]).abs() / m.max(1e-30);
-            worst = worst.max(if m > 0.0 { e } else { (a[c] - b[c]).abs() });
-        }
-    }
+    let (lit, worst) = assert_pixels_close(&scalar, &on_gpu, SHADE_MOMENTS_REL_TOL as f64);
     gpu_common::say(&format!(
         "rsl scene on wgpu: {lit} lit pixels, worst {worst:.2e} of the pixel's largest channel"
     ));
     assert!(lit > 800, "{lit}");
-    assert!(worst <= SHADE_MOMENTS_REL_TOL as f64, "{worst}");
 }
 
 /// `rsl` plans K from the target error (`choose_k`): the estimates fall with K, the chosen
