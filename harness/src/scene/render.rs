@@ -76,9 +76,7 @@ pub struct Options {
     pub gpu: bool,
 }
 
-/// The default `--target-error`: half the cosine-lobe paper's mean |difference| over the
-/// maximum radiance (0.0039 / 0.70 = 0.56 %, its Figure 15), as the scenes issue asks.
-pub const DEFAULT_TARGET_ERROR: f64 = 0.0028;
+pub use super::DEFAULT_TARGET_ERROR;
 
 impl Default for Options {
     fn default() -> Self {

@@ -59,7 +59,7 @@ impl Default for Options {
             face: 32,
             vis_side: 32,
             sat_target: 0.005,
-            vis_depth: coverage_depth_for(super::render::DEFAULT_TARGET_ERROR),
+            vis_depth: coverage_depth_for(super::DEFAULT_TARGET_ERROR),
         }
     }
 }
