@@ -7,7 +7,10 @@
 //! [`REFERENCE_SPP`] samples per pixel ([`ENVIRONMENT_REFERENCE_SPP`] for `environment`,
 //! whose reference is the noisiest per sample), direct light for `lobes` and `cluster` and
 //! one bounce for `room`; the path tracer's curve is the same tracer with other seeds at
-//! [`PATH_SPP`] samples. The `lobes` method's curve is its pruning threshold, with the L2 cap fit and
+//! [`PATH_SPP`] samples. The default point of `lobes` and `hvl` is what `steradian render`
+//! plans at the default target error ([`planned`]). The `lobes` method's curve is its
+//! pruning threshold at the planned quadtree depth and every other depth at the planned
+//! threshold, with the L2 cap fit and
 //! one lobe per occluder (instead of the default energy-preserving fit and quadtree mask)
 //! beside it; the `hvl` method's curve is its HVL count, with the paper's choice of no
 //! HVL visibility and the direct light alone beside it; the `rsl` method's is its number
@@ -30,7 +33,7 @@ use super::plot::{Axis, Chart, Pt, Scale, Series};
 use super::section::Section;
 use crate::scene::image::Image;
 use crate::scene::metrics::{self, Metrics};
-use crate::scene::{Scene, Seen, hvl, lobes, path, rsl};
+use crate::scene::{Scene, Seen, hvl, lobes, path, render, rsl};
 
 /// Image width of the section's renders (the height follows each scene's aspect ratio).
 pub const WIDTH: u32 = 96;
@@ -86,6 +89,8 @@ struct SceneResult {
     per_core: Vec<(&'static str, String, f64, usize)>,
     /// The path tracer's time at the default point's error over that point's time.
     equal_error_ratio: f64,
+    /// Index of the default point in `curve`.
+    default: usize,
     files: Vec<(String, Vec<u8>)>,
 }
 
@@ -154,9 +159,32 @@ struct Setting<'a> {
     per_core: Option<&'static str>,
 }
 
+/// The options `steradian render` plans for `scene` and `method` at the default target
+/// error (`scene::render::plan`), so that a default point is what a user gets; the
+/// methods' own defaults where the plan refuses the scene.
+fn planned(scene: &Scene, method: render::Method) -> Option<render::Plan> {
+    render::plan(
+        scene,
+        &render::Options {
+            method,
+            quiet: true,
+            ..render::Options::default()
+        },
+    )
+    .ok()
+}
+
+/// The depth of a mask visibility (the deepest level for one lobe per occluder).
+fn mask_depth(v: lobes::Visibility) -> u32 {
+    match v {
+        lobes::Visibility::Mask { depth, .. } => depth,
+        lobes::Visibility::PerOccluder => steradian_core::lobe::mask::MAX_DEPTH,
+    }
+}
+
 fn lobes_settings(scene: &Scene) -> (Vec<Setting<'_>>, Vec<Setting<'_>>) {
     let px = scene.camera.pixels() as f64;
-    let d = lobes::Options::default();
+    let d = planned(scene, render::Method::Lobes).map_or_else(lobes::Options::default, |p| p.lobes);
     let mk = move |label: String, o: lobes::Options, default: bool| Setting {
         label,
         render: Box::new(move || {
@@ -167,19 +195,39 @@ fn lobes_settings(scene: &Scene) -> (Vec<Setting<'_>>, Vec<Setting<'_>>) {
         build_seconds: None,
         per_core: default.then_some("scalar"),
     };
-    let curve = THRESHOLDS
+    let depth = mask_depth(d.visibility);
+    // The curve's thresholds and the planned one (`--target-error`/10).
+    let mut thresholds = THRESHOLDS.to_vec();
+    if !thresholds.contains(&d.threshold) {
+        thresholds.push(d.threshold);
+        thresholds.sort_by(f32::total_cmp);
+    }
+    let mut curve: Vec<Setting<'_>> = thresholds
         .iter()
         .map(|&t| {
             mk(
-                format!("t = {t:.0e}"),
+                format!("t = {t:.0e}, depth {depth}"),
                 lobes::Options { threshold: t, ..d },
                 t == d.threshold,
             )
         })
         .collect();
+    // The quadtree depths the plan did not choose, at its threshold.
+    if let lobes::Visibility::Mask { leaves, .. } = d.visibility {
+        for k in (1..=steradian_core::lobe::mask::MAX_DEPTH).filter(|&k| k != depth) {
+            curve.push(mk(
+                format!("t = {:.0e}, depth {k}", d.threshold),
+                lobes::Options {
+                    visibility: lobes::Visibility::Mask { depth: k, leaves },
+                    ..d
+                },
+                false,
+            ));
+        }
+    }
     let variants = vec![
         mk(
-            format!("L2 cap fit, t = {:.0e}", d.threshold),
+            format!("L2 cap fit, t = {:.0e}, depth {depth}", d.threshold),
             lobes::Options {
                 fit: CapFit::L2,
                 ..d
@@ -199,7 +247,7 @@ fn lobes_settings(scene: &Scene) -> (Vec<Setting<'_>>, Vec<Setting<'_>>) {
 }
 
 fn hvl_settings(scene: &Scene) -> (Vec<Setting<'_>>, Vec<Setting<'_>>) {
-    let d = hvl::Options::default();
+    let d = planned(scene, render::Method::Hvl).map_or_else(hvl::Options::default, |p| p.hvl);
     let mk = move |label: String, o: hvl::Options, default: bool| Setting {
         label,
         render: Box::new(move || (hvl::render(scene, &o, &ProgressBar::hidden()).0, None)),
@@ -378,7 +426,7 @@ fn measure_scene(
     for st in &curve_settings {
         let (p, img) = measure(st)?;
         if st.default {
-            default_img = Some((p.clone(), img));
+            default_img = Some((curve.len(), p.clone(), img));
         }
         curve.push(p);
     }
@@ -403,7 +451,7 @@ fn measure_scene(
         per_core.push((kernel, st.label.clone(), s, surface_points));
     }
     bar.inc(1);
-    let (dp, dimg) = default_img.ok_or("the default setting is on the curve")?;
+    let (default, dp, dimg) = default_img.ok_or("the default setting is on the curve")?;
     let equal_error_ratio = cost_ratios(&path_curve, &dp).0.unwrap_or(f64::NAN);
     let diff = metrics::difference_image(
         &class,
@@ -429,6 +477,7 @@ fn measure_scene(
         variants,
         per_core,
         equal_error_ratio,
+        default,
         files,
     })
 }
@@ -507,11 +556,7 @@ pub fn section(opts: &Options) -> Result<Section, Box<dyn Error>> {
     )?;
     writeln!(summary, "  wgpu: {gpu_note}")?;
     for r in &results {
-        let d = r
-            .curve
-            .iter()
-            .find(|p| p.setting.contains(&default_label(r.method)))
-            .unwrap_or(&r.curve[0]);
+        let d = &r.curve[r.default];
         let variants: Vec<String> = r
             .variants
             .iter()
@@ -631,16 +676,4 @@ pub fn section(opts: &Options) -> Result<Section, Box<dyn Error>> {
         data: json!({ "scenes": data, "gpu": gpu_note }),
         files,
     })
-}
-
-/// The label of a method's default setting on its curve.
-fn default_label(method: &str) -> String {
-    match method {
-        "hvl" => {
-            let side = hvl::Options::default().side;
-            format!("{} HVLs", 6 * side * side)
-        }
-        "rsl" => format!("K = {}", rsl::Options::default().k),
-        _ => format!("t = {:.0e}", lobes::Options::default().threshold),
-    }
 }

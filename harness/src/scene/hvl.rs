@@ -212,6 +212,61 @@ pub fn indirect(
     [acc[0] * albedo[0], acc[1] * albedo[1], acc[2] * albedo[2]]
 }
 
+/// The reflective-shadow-map face sides a plan tries, smallest first ([`choose_side`]):
+/// `6·side²` HVLs per light.
+pub const SIDE_CANDIDATES: [usize; 5] = [2, 4, 8, 12, 16];
+
+/// What [`choose_side`] chose and what it measured.
+#[derive(Clone, Debug)]
+pub struct SideChoice {
+    /// The chosen face side.
+    pub side: usize,
+    /// `(side, estimate)`: the probes' mean |difference| from the largest candidate over its
+    /// largest value ([`super::probe_estimates`]).
+    pub estimates: Vec<(usize, f64)>,
+}
+
+/// The smallest face side of [`SIDE_CANDIDATES`] whose HVLs keep the shaded probes within
+/// [`super::PLAN_SHARE`] of `target` (mean |difference| over the maximum radiance, the render's measure) of
+/// the largest candidate's. The probes are the [`super::probe_points`] grid; each is lit by
+/// the same direct light (`o.direct`) for every side, so the difference is the HVL count's
+/// alone, and the largest value includes the direct light as the render's does. The rest
+/// of the target is left to the direct light and to the HVL approximation itself. The
+/// largest candidate if none is within.
+pub fn choose_side(scene: &Scene, o: &Options, target: f64) -> SideChoice {
+    let probes = super::probe_points(scene);
+    let mut counts = ProductCounts::default();
+    let direct: Vec<Rgb> = probes
+        .iter()
+        .map(|p| lobes::shade(scene, p, &o.direct, &mut counts))
+        .collect();
+    let mut scratch = Scratch::default();
+    let images: Vec<Vec<Rgb>> = SIDE_CANDIDATES
+        .iter()
+        .map(|&side| {
+            let hvls = place(scene, side);
+            probes
+                .iter()
+                .zip(&direct)
+                .map(|(p, d)| {
+                    let i = indirect(scene, p, &hvls, o.visibility, &mut scratch);
+                    [d[0] + i[0], d[1] + i[1], d[2] + i[2]]
+                })
+                .collect()
+        })
+        .collect();
+    let estimates: Vec<(usize, f64)> = SIDE_CANDIDATES
+        .iter()
+        .copied()
+        .zip(super::probe_estimates(&images))
+        .collect();
+    let side = estimates
+        .iter()
+        .find(|&&(_, e)| e <= super::PLAN_SHARE * target)
+        .map_or(SIDE_CANDIDATES[SIDE_CANDIDATES.len() - 1], |&(s, _)| s);
+    SideChoice { side, estimates }
+}
+
 /// Direct light by the `lobes` method plus one bounce from HVLs, one pixel-centre sample
 /// per pixel ([`super::render_centres`]); returns the image and the HVL count.
 pub fn render(scene: &Scene, o: &Options, bar: &ProgressBar) -> (Image, usize) {

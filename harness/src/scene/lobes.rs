@@ -179,6 +179,56 @@ pub fn shade(scene: &Scene, p: &ShadingPoint, o: &Options, counts: &mut ProductC
     out
 }
 
+/// What [`choose_depth`] chose and what it measured.
+#[derive(Clone, Debug)]
+pub struct DepthChoice {
+    /// The chosen deepest level of the quadtree mask.
+    pub depth: u32,
+    /// `(depth, estimate)`: the probes' mean |difference| from the deepest mask over its
+    /// largest value ([`super::probe_estimates`]).
+    pub estimates: Vec<(u32, f64)>,
+}
+
+/// The shallowest quadtree mask (levels `1 ..= mask::MAX_DEPTH`) that keeps the shaded
+/// probes within [`super::PLAN_SHARE`] of `target` (mean |difference| over the maximum radiance,
+/// the render's measure) of the deepest mask's: the probes are the [`super::probe_points`]
+/// grid, shaded with `o` but for the depth, so the difference is the depth's alone. The
+/// deepest level when `o` does not use the mask or none is within.
+pub fn choose_depth(scene: &Scene, o: &Options, target: f64) -> DepthChoice {
+    let Visibility::Mask { leaves, .. } = o.visibility else {
+        return DepthChoice {
+            depth: mask::MAX_DEPTH,
+            estimates: Vec::new(),
+        };
+    };
+    let probes = super::probe_points(scene);
+    let mut counts = ProductCounts::default();
+    let depths: Vec<u32> = (1..=mask::MAX_DEPTH).collect();
+    let images: Vec<Vec<Rgb>> = depths
+        .iter()
+        .map(|&depth| {
+            let od = Options {
+                visibility: Visibility::Mask { depth, leaves },
+                ..*o
+            };
+            probes
+                .iter()
+                .map(|p| shade(scene, p, &od, &mut counts))
+                .collect()
+        })
+        .collect();
+    let estimates: Vec<(u32, f64)> = depths
+        .iter()
+        .copied()
+        .zip(super::probe_estimates(&images))
+        .collect();
+    let depth = estimates
+        .iter()
+        .find(|&&(_, e)| e <= super::PLAN_SHARE * target)
+        .map_or(mask::MAX_DEPTH, |&(d, _)| d);
+    DepthChoice { depth, estimates }
+}
+
 /// One pixel-centre sample per pixel ([`super::render_centres`]), surfaces shaded by
 /// [`shade`]; the product counts of the whole image.
 pub fn render(scene: &Scene, o: &Options, bar: &ProgressBar) -> (Image, ProductCounts) {

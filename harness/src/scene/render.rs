@@ -191,11 +191,12 @@ pub fn plan(scene: &Scene, o: &Options) -> Result<Plan, String> {
                 value: json!(r.k),
                 reason: format!(
                     "K square lights from a 6 × {}² cube map: the smallest of {:?} whose \
-                     decomposition alone keeps {} probe pixels within half the target {} of \
+                     decomposition alone keeps {} probe pixels within {} of the target {} of \
                      the largest ({}; the RSL paper uses K = 30)",
                     r.face,
                     super::rsl::K_CANDIDATES,
-                    super::rsl::K_PROBES.0 * super::rsl::K_PROBES.1,
+                    super::PROBES.0 * super::PROBES.1,
+                    super::PLAN_SHARE,
                     o.target_error,
                     est.join(", ")
                 ),
@@ -294,17 +295,71 @@ pub fn plan(scene: &Scene, o: &Options) -> Result<Plan, String> {
                 value: json!("built-in 64 exponents × 128 angles"),
                 reason: "the committed lobe-product table covers exponents 0–1e5".into(),
             });
+            let choice = lobes::choose_depth(scene, &lo, o.target_error);
+            if let lobes::Visibility::Mask { leaves, .. } = lo.visibility {
+                lo.visibility = lobes::Visibility::Mask {
+                    depth: choice.depth,
+                    leaves,
+                };
+            }
+            let est: Vec<String> = choice
+                .estimates
+                .iter()
+                .map(|(d, e)| format!("depth {d}: {e:.1e}"))
+                .collect();
             p.push(PlanItem {
                 item: "visibility".into(),
-                value: json!(format!(
-                    "quadtree mask, depth {}",
-                    steradian_core::lobe::mask::MAX_DEPTH
-                )),
-                reason:
-                    "section 5.3: one lobe per shadow leaf with the fitted weights w(dist, depth) \
-                         (the table's fit depth); overlapping occluders are counted once"
-                        .into(),
+                value: json!(format!("quadtree mask, depth {}", choice.depth)),
+                reason: format!(
+                    "section 5.3: one lobe per shadow leaf with the fitted weights w(dist, depth), \
+                     overlapping occluders counted once; {} is the shallowest depth that keeps \
+                     {} probe pixels within {} of the target {} of depth {} ({})",
+                    choice.depth,
+                    super::PROBES.0 * super::PROBES.1,
+                    super::PLAN_SHARE,
+                    o.target_error,
+                    steradian_core::lobe::mask::MAX_DEPTH,
+                    est.join(", ")
+                ),
             });
+            if o.method == Method::Hvl {
+                hv.direct = lo;
+                let choice = super::hvl::choose_side(scene, &hv, o.target_error);
+                hv.side = choice.side;
+                let est: Vec<String> = choice
+                    .estimates
+                    .iter()
+                    .map(|(side, e)| format!("side {side}: {e:.1e}"))
+                    .collect();
+                p.push(PlanItem {
+                    item: "hvls".into(),
+                    value: json!(6 * hv.side * hv.side * scene.lights.len()),
+                    reason: format!(
+                        "a reflective shadow map of 6 × {0}² rays per light, one HVL per hit: \
+                         {0} is the smallest face side of {1:?} whose HVLs keep {2} probe \
+                         pixels within {3} of the target {4} of the largest side's ({5})",
+                        hv.side,
+                        super::hvl::SIDE_CANDIDATES,
+                        super::PROBES.0 * super::PROBES.1,
+                        super::PLAN_SHARE,
+                        o.target_error,
+                        est.join(", ")
+                    ),
+                });
+                p.push(PlanItem {
+                    item: "sh_bands".into(),
+                    value: json!(steradian_core::sh::brdf::lambert().bands()),
+                    reason: "the receiver's diffuse albedo times the committed Lambert BRDF \
+                             table (with the cosine); Lambertian emission is exact in one band; \
+                             glossy parts are not carried by the indirect term"
+                        .into(),
+                });
+                p.push(PlanItem {
+                    item: "hvl_visibility".into(),
+                    value: json!(hv.visibility),
+                    reason: "a shadow ray per HVL–receiver pair (the paper tests none)".into(),
+                });
+            }
         }
     }
     hv.direct = lo;

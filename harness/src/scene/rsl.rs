@@ -159,9 +159,6 @@ pub fn build_many(scene: &Scene, o: &Options, ks: &[usize]) -> Result<BuiltMany,
 /// The `K` a plan tries, smallest first ([`choose_k`]).
 pub const K_CANDIDATES: [usize; 5] = [10, 30, 100, 300, 1000];
 
-/// Probe pixels per image side of [`choose_k`] (a grid of pixel centres).
-pub const K_PROBES: (u32, u32) = (16, 12);
-
 /// What [`choose_k`] chose and what it measured.
 #[derive(Clone, Debug)]
 pub struct KChoice {
@@ -173,11 +170,11 @@ pub struct KChoice {
 }
 
 /// The smallest `K` of [`K_CANDIDATES`] whose light decomposition alone keeps the shaded
-/// probes within half of `target` (mean |difference| over the maximum radiance, the
-/// render's measure) of the largest candidate's: the probes are a [`K_PROBES`] grid of
-/// pixel centres that meet a surface, shaded with the same visibility and BRDF SATs for
+/// probes within [`super::PLAN_SHARE`] of `target` (mean |difference| over the maximum radiance, the
+/// render's measure) of the largest candidate's ([`super::probe_estimates`]): the probes
+/// are the [`super::probe_points`] grid, shaded with the same visibility and BRDF SATs for
 /// every `K`, so the difference is the decomposition's alone (the error that dominates
-/// `rsl` on the built-in scenes; the other half of the target is left to visibility and
+/// `rsl` on the built-in scenes; the rest of the target is left to visibility and
 /// the SATs). The largest candidate if none is within.
 pub fn choose_k(scene: &Scene, o: &Options, target: f64) -> Result<KChoice, String> {
     let texels = 6 * o.face * o.face;
@@ -191,20 +188,11 @@ pub fn choose_k(scene: &Scene, o: &Options, target: f64) -> Result<KChoice, Stri
         lambert,
         specular,
     } = build_many(scene, o, &ks)?;
-    let cam = scene.camera;
     let mut cov = vec![0.0f32; o.vis_side * o.vis_side];
-    let mut probes = Vec::new();
-    for b in 0..K_PROBES.1 {
-        for a in 0..K_PROBES.0 {
-            let i = ((2 * a + 1) * cam.width / (2 * K_PROBES.0)).min(cam.width - 1);
-            let j = ((2 * b + 1) * cam.height / (2 * K_PROBES.1)).min(cam.height - 1);
-            if let Seen::Surface(p) = scene.see(&cam.centre_ray(i, j))
-                && let Some(t) = point_moments(scene, o, &p, &mut cov)
-            {
-                probes.push((p, t));
-            }
-        }
-    }
+    let probes: Vec<_> = super::probe_points(scene)
+        .into_iter()
+        .filter_map(|p| point_moments(scene, o, &p, &mut cov).map(|t| (p, t)))
+        .collect();
     // The probes shaded with each K's lights (the SATs shared).
     let mut b = Built {
         lights: Vec::new(),
@@ -222,28 +210,18 @@ pub fn choose_k(scene: &Scene, o: &Options, target: f64) -> Result<KChoice, Stri
             (k, img)
         })
         .collect();
-    let Some((_, reference)) = shaded.last() else {
+    if shaded.is_empty() {
         return Err("no candidate K fits the cube map".into());
-    };
-    let max = reference
-        .iter()
-        .flat_map(|c| c.iter().copied())
-        .fold(0.0, f64::max);
-    let mut estimates = Vec::new();
-    let mut chosen = None;
-    for (k, img) in &shaded {
-        let n = (3 * img.len()).max(1) as f64;
-        let sum: f64 = img
-            .iter()
-            .zip(reference)
-            .map(|(a, r)| (0..3).map(|c| (a[c] - r[c]).abs()).sum::<f64>())
-            .sum();
-        let e = if max > 0.0 { sum / n / max } else { 0.0 };
-        estimates.push((*k, e));
-        if chosen.is_none() && e <= 0.5 * target {
-            chosen = Some(*k);
-        }
     }
+    let (order, images): (Vec<usize>, Vec<Vec<Rgb>>) = shaded.into_iter().unzip();
+    let estimates: Vec<(usize, f64)> = order
+        .into_iter()
+        .zip(super::probe_estimates(&images))
+        .collect();
+    let chosen = estimates
+        .iter()
+        .find(|&&(_, e)| e <= super::PLAN_SHARE * target)
+        .map(|&(k, _)| k);
     Ok(KChoice {
         k: chosen.unwrap_or(ks[ks.len() - 1]),
         estimates,
