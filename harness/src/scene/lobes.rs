@@ -119,7 +119,9 @@ pub fn shade(scene: &Scene, p: &ShadingPoint, o: &Options, counts: &mut ProductC
             constant: 1.0,
             lobes: Vec::new(),
         };
-        let (d_light, a_light) = (rel.length(), cap.half_angle() as f64);
+        let d_light = rel.length();
+        let (s_light, a_light) = ((light.radius / d_light).min(1.0), rel / d_light);
+        let c_light = (1.0 - s_light * s_light).max(0.0).sqrt();
         let mut occluders = Vec::new();
         for (id, obj) in scene.objects.iter().enumerate() {
             if id == self_id || obj.kind == Kind::Light(li) {
@@ -129,16 +131,25 @@ pub fn shade(scene: &Scene, p: &ShadingPoint, o: &Options, counts: &mut ProductC
                 continue;
             };
             let rc = center - x;
-            if rc.length() >= d_light {
+            let d2 = rc.length_squared();
+            if d2 >= d_light * d_light {
+                continue;
+            }
+            // The caps overlap iff the angle θ between their axes is below α_l + α_o:
+            // cos θ > cos α_l·cos α_o − sin α_l·sin α_o (both angles in [0, π/2],
+            // sin α_o = r/d), times d: rc·a_l > cos α_l·√(d² − r²) − sin α_l·r. One square
+            // root and no inverse trigonometry for a sphere that is culled.
+            let (tangent, r_in) = if d2 > radius * radius {
+                ((d2 - radius * radius).sqrt(), radius)
+            } else {
+                (0.0, d2.sqrt())
+            };
+            if rc.dot(a_light) <= c_light * tangent - s_light * r_in {
                 continue;
             }
             let Ok(oc) = SphericalCap::from_sphere(Vec3::ZERO, f32v(rc), radius as f32) else {
                 continue;
             };
-            let between = rc.normalize().dot(rel / d_light).clamp(-1.0, 1.0).acos();
-            if between >= a_light + oc.half_angle() as f64 {
-                continue;
-            }
             occluders.push(oc);
         }
         match o.visibility {
