@@ -415,6 +415,42 @@ pub fn eval_into(dir: Vec3, bands: usize, out: &mut [f32]) -> Result<(), Error> 
     Ok(())
 }
 
+/// The zonal functions `Y_l^0`, `l < bands`, at `dir` into `out[..bands]`: the `m = 0`
+/// chain of [`eval_into`]'s recurrence alone (`Π_0^0`, `Π_1^0 = √3·z·Π_0^0`, then
+/// [`step`]), the same operations on the same `f64` unit vector, so each value is
+/// bit-identical to `eval_into`'s at index `l² + l` (tested). What a receiver whose
+/// coefficients are zonal around its normal needs (`sh::hvl::contribution_zonal`): `bands`
+/// values instead of `bands²`.
+///
+/// Errors: `bands > MAX_BANDS`, or `out` shorter than `bands`.
+pub fn eval_zonal_into(dir: Vec3, bands: usize, out: &mut [f32]) -> Result<(), Error> {
+    check_shape(bands, usize::MAX)?;
+    if out.len() < bands {
+        return Err(Error::OutOfRange {
+            what: "SH output length",
+            value: out.len() as f32,
+            min: bands as f32,
+            max: f32::INFINITY,
+        });
+    }
+    if bands == 0 {
+        return Ok(());
+    }
+    let z = unit_direction(dir).z;
+    out[0] = (Y00_F64 + 0.0 * z) as f32;
+    let (mut q1, mut q2) = (Y00_F64, 0.0f64);
+    for (l, o) in out[..bands].iter_mut().enumerate().skip(1) {
+        let q = if l == 1 {
+            SUB[0] * z * q1
+        } else {
+            step(tri(l, 0), z, q1, q2)
+        };
+        (q2, q1) = (q1, q);
+        *o = q as f32;
+    }
+    Ok(())
+}
+
 /// The checks of every SH entry point: `bands ≤ MAX_BANDS` and an output of at least
 /// `bands²` values (`len`).
 pub fn check_shape(bands: usize, len: usize) -> Result<(), Error> {
@@ -670,6 +706,31 @@ mod tests {
             let b: [f32; 100] = eval_fixed(d);
             assert_eq!(b.as_slice(), eval(d, 10).as_slice());
         }
+    }
+
+    #[test]
+    fn zonal_chain_is_eval_into_at_m_zero_bit_for_bit() {
+        let mut dirs = directions();
+        dirs.extend([
+            Vec3::ZERO,
+            Vec3::new(0.0, 0.0, -3.0),
+            Vec3::new(1.0, 0.0, 0.0),
+            Vec3::new(f32::NAN, 0.0, 1.0),
+            Vec3::new(1e-30, 1e-30, 1e-30),
+        ]);
+        for n in [0usize, 1, 2, 3, 5, 10, 30, MAX_BANDS] {
+            for &d in &dirs {
+                let full = eval(d, n);
+                let mut z = vec![7.0f32; n];
+                eval_zonal_into(d, n, &mut z).unwrap();
+                for (l, v) in z.iter().enumerate() {
+                    assert_eq!(v.to_bits(), full[l * l + l].to_bits(), "{d:?} n {n} l {l}");
+                }
+            }
+        }
+        let mut short = [0.0f32; 2];
+        assert!(eval_zonal_into(Vec3::Z, 3, &mut short).is_err());
+        assert!(eval_zonal_into(Vec3::Z, MAX_BANDS + 1, &mut [0.0; 200]).is_err());
     }
 
     #[test]
