@@ -93,8 +93,8 @@ enum Command {
         /// No progress bar.
         #[arg(long)]
         quiet: bool,
-        /// Shade with the scalar kernels (otherwise rsl shades eight points at a time with
-        /// its SIMD kernel and hvl sums four HVLs at a time with its SIMD kernel).
+        /// Shade with the scalar kernels (rsl shades eight points at a time with its SIMD
+        /// kernel otherwise; the other methods are scalar).
         #[arg(long)]
         scalar: bool,
         /// Shade on the wgpu backend (rsl; an error without an adapter).

@@ -821,26 +821,3 @@ fn hvl_plans_the_hvl_count_from_the_target_error() {
         "{m:?}"
     );
 }
-
-/// The `hvl` method's SIMD path (the default: `steradian_simd::sh::hvl::contributions`, four
-/// HVLs at a time) gives the scalar path's image bit for bit: the SIMD contribution kernel
-/// is bit-identical lane by lane, and the sums run in the same order.
-#[test]
-fn hvl_simd_path_matches_the_scalar_path_bit_for_bit() {
-    use steradian_harness::scene::hvl;
-    let mut s = Scene::load("builtin:room").unwrap();
-    s.camera = s.camera.resized(48).unwrap();
-    let hidden = ProgressBar::hidden();
-    let d = hvl::Options::default();
-    assert!(d.simd);
-    let (simd, count) = hvl::render(&s, &d, &hidden);
-    let (scalar, _) = hvl::render(&s, &hvl::Options { simd: false, ..d }, &hidden);
-    assert!(count > 0);
-    let lit = simd.data.iter().filter(|p| p[1] > 0.0).count();
-    assert!(lit > 1000, "{lit}");
-    for (k, (a, b)) in simd.data.iter().zip(&scalar.data).enumerate() {
-        for c in 0..3 {
-            assert_eq!(a[c].to_bits(), b[c].to_bits(), "pixel {k} channel {c}");
-        }
-    }
-}

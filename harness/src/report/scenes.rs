@@ -253,7 +253,7 @@ fn hvl_settings(scene: &Scene) -> (Vec<Setting<'_>>, Vec<Setting<'_>>) {
         render: Box::new(move || (hvl::render(scene, &o, &ProgressBar::hidden()).0, None)),
         default,
         build_seconds: None,
-        per_core: default.then_some(if o.simd { "simd" } else { "scalar" }),
+        per_core: default.then_some("scalar"),
     };
     let curve = HVL_SIDES
         .iter()
@@ -267,16 +267,7 @@ fn hvl_settings(scene: &Scene) -> (Vec<Setting<'_>>, Vec<Setting<'_>>) {
         .collect();
     let px = scene.camera.pixels() as f64;
     let direct = d.direct;
-    let count = 6 * d.side * d.side * scene.lights.len();
     let variants = vec![
-        Setting {
-            per_core: Some("scalar"),
-            ..mk(
-                format!("{count} HVLs, scalar kernel"),
-                hvl::Options { simd: false, ..d },
-                false,
-            )
-        },
         mk(
             format!(
                 "{} HVLs, no HVL visibility (the paper)",

@@ -359,18 +359,6 @@ pub fn plan(scene: &Scene, o: &Options) -> Result<Plan, String> {
                     value: json!(hv.visibility),
                     reason: "a shadow ray per HVL–receiver pair (the paper tests none)".into(),
                 });
-                hv.simd = !o.scalar;
-                p.push(PlanItem {
-                    item: "hvl_kernel".into(),
-                    value: json!(if hv.simd { "simd" } else { "scalar" }),
-                    reason: if hv.simd {
-                        "the SIMD contribution kernel, four HVLs at a time (bit-identical to \
-                         the scalar one; --scalar for it)"
-                            .into()
-                    } else {
-                        "--scalar: the scalar contribution kernel, one HVL at a time".into()
-                    },
-                });
             }
         }
     }
