@@ -51,12 +51,13 @@ enum Command {
         /// Kernel name (see below).
         kernel: String,
     },
-    /// Regenerate the precomputed tables under core/src/lobe/tables.
+    /// Regenerate the precomputed tables (core/src/*/tables) and the generated SH code
+    /// (core/src/sh/fixed.rs, simd/src/sh/fixed.rs).
     Tables {
         /// Do not write: fail if the committed tables differ from a fresh generation.
         #[arg(long)]
         check: bool,
-        /// Directory of the tables (default: this source tree's core/src/lobe/tables).
+        /// Root of the tree the files are written under (default: this source tree).
         #[arg(long)]
         dir: Option<PathBuf>,
     },
@@ -242,7 +243,7 @@ fn main() -> ExitCode {
                             (true, false) => "DIFFERS from a fresh generation",
                         };
                         ok &= o.matches;
-                        println!("{:<30} {:>8} bytes  {what}", o.file, o.bytes);
+                        println!("{:<40} {:>8} bytes  {what}", o.file, o.bytes);
                     }
                     if ok {
                         ExitCode::SUCCESS

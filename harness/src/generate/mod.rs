@@ -1,18 +1,20 @@
 //! Table generators. Each built-in table of `steradian-core` is produced here in f64 from
 //! its exact definition, encoded with `steradian_core::table`, and committed beside the
-//! module that reads it (`core/src/lobe/tables/`, `core/src/sh/tables/`). `steradian tables` rewrites them; `steradian tables --check`
+//! module that reads it (`core/src/lobe/tables/`, `core/src/sh/tables/`); so is the
+//! straight-line SH code of `core/src/sh/fixed.rs` and `simd/src/sh/fixed.rs`. `steradian tables` rewrites them; `steradian tables --check`
 //! regenerates in memory and fails if a committed file differs.
 
 pub mod brdf_sh;
 pub mod cap_exponent;
 pub mod lobe_product;
 pub mod mask_weights;
+pub mod sh_fixed;
 
 use std::path::{Path, PathBuf};
 
 /// A built-in table: its path under `core/src/` and its generator.
 pub struct TableDef {
-    /// Path under `core/src/`, e.g. `lobe/tables/cap_exponent.bin`.
+    /// Path from the repository root, e.g. `core/src/lobe/tables/cap_exponent.bin`.
     pub file: &'static str,
     /// What the table holds.
     pub about: &'static str,
@@ -23,45 +25,55 @@ pub struct TableDef {
 /// Every built-in table.
 pub const TABLES: &[TableDef] = &[
     TableDef {
-        file: "lobe/tables/cap_exponent.bin",
+        file: "core/src/lobe/tables/cap_exponent.bin",
         about: "h(α) = e*(α)·α², L2-optimal cap exponent, uniform over [0, π/2]",
         generate: cap_exponent::generate,
     },
     TableDef {
-        file: "lobe/tables/lobe_product.bin",
+        file: "core/src/lobe/tables/lobe_product.bin",
         about: "g = ln I − ln B, the lobe-product integral's correction to its closed-form baseline",
         generate: lobe_product::generate,
     },
     TableDef {
-        file: "lobe/tables/mask_weights.bin",
+        file: "core/src/lobe/tables/mask_weights.bin",
         about: "w(dist, depth), the quadtree mask's leaf weights, least squares against exact visibility",
         generate: mask_weights::generate,
     },
     TableDef {
-        file: "sh/tables/brdf_lambert.bin",
+        file: "core/src/sh/tables/brdf_lambert.bin",
         about: "SH of Lambert (albedo 1) with and without the cosine, per view",
         generate: brdf_sh::generate_lambert,
     },
     TableDef {
-        file: "sh/tables/brdf_phong30.bin",
+        file: "core/src/sh/tables/brdf_phong30.bin",
         about: "SH of modified Phong (specular 1, exponent 30), per view",
         generate: brdf_sh::generate_phong,
     },
     TableDef {
-        file: "sh/tables/brdf_lafortune.bin",
+        file: "core/src/sh/tables/brdf_lafortune.bin",
         about: "SH of a two-lobe Lafortune BRDF, per view",
         generate: brdf_sh::generate_lafortune,
     },
     TableDef {
-        file: "sh/tables/brdf_ggx.bin",
+        file: "core/src/sh/tables/brdf_ggx.bin",
         about: "SH of GGX (F0 0.04, alpha 0.3) with Schlick Fresnel, per view",
         generate: brdf_sh::generate_ggx,
     },
+    TableDef {
+        file: "core/src/sh/fixed.rs",
+        about: "straight-line SH evaluation for 2–10 bands: the recurrence unrolled, its coefficients as literals",
+        generate: sh_fixed::generate,
+    },
+    TableDef {
+        file: "simd/src/sh/fixed.rs",
+        about: "the same straight-line evaluation on f64 lanes, for the SIMD twin",
+        generate: sh_fixed::generate_lanes,
+    },
 ];
 
-/// `core/src` of this source tree (the table paths are relative to it).
+/// The root of this source tree (the table paths are relative to it).
 pub fn default_dir() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("../core/src")
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("..")
 }
 
 /// Outcome of writing or checking one table.

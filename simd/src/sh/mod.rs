@@ -23,6 +23,9 @@ pub mod rotate;
 
 use core::ops::{Add, Mul, Sub};
 use steradian_core::sh::{A, AB, CHAINS, DIAG, MAX_GROUP, SUB, Y00_F64, check_shape, group, tri};
+#[rustfmt::skip]
+mod fixed;
+
 use steradian_core::{Error, Vec3};
 use wide::{f64x4, f64x8};
 
@@ -86,8 +89,20 @@ lanes_kernels!(f64x8, 8, eval_x8, narrow8, unit_lanes8, "eight");
 /// part, coefficient 0 last, as the scalar kernel writes them).
 #[inline(always)]
 fn fill<F: F64Lanes>(u: [F; 3], bands: usize, put: &mut impl FnMut(usize, F)) {
-    if bands == 0 {
-        return;
+    // The straight-line code generated from this recurrence for 2–10 bands (the same
+    // operations per value, as the scalar kernel's).
+    match bands {
+        0 => return,
+        2 => return fixed::fill_2(u, put),
+        3 => return fixed::fill_3(u, put),
+        4 => return fixed::fill_4(u, put),
+        5 => return fixed::fill_5(u, put),
+        6 => return fixed::fill_6(u, put),
+        7 => return fixed::fill_7(u, put),
+        8 => return fixed::fill_8(u, put),
+        9 => return fixed::fill_9(u, put),
+        10 => return fixed::fill_10(u, put),
+        _ => {}
     }
     let [x, y, z] = u;
     let sp = F::splat;
