@@ -656,6 +656,23 @@ fn rsl_gpu_path_matches_the_scalar_path_pixel_by_pixel() {
     assert!(lit > 800, "{lit}");
 }
 
+/// A plan's probe estimates fall (to 0 at the finest candidate, which stands in for the
+/// reference) and its choice is the first candidate within `PLAN_SHARE` of `target`.
+fn assert_choice<T: Copy + PartialEq + std::fmt::Debug>(
+    estimates: &[(T, f64)],
+    chosen: T,
+    target: f64,
+) {
+    let e: Vec<f64> = estimates.iter().map(|x| x.1).collect();
+    assert!(e.windows(2).all(|w| w[1] <= w[0]), "{estimates:?}");
+    assert_eq!(e.last(), Some(&0.0), "{estimates:?}");
+    let first = estimates
+        .iter()
+        .find(|x| x.1 <= scene::PLAN_SHARE * target)
+        .map(|x| x.0);
+    assert_eq!(first, Some(chosen), "{estimates:?}");
+}
+
 /// `rsl` plans K from the target error (`choose_k`): the estimates fall with K, the chosen
 /// K is the smallest within `PLAN_SHARE` of the target, a loose target takes a small K, and the
 /// render at the chosen K meets the target against the path tracer (plus four times the
@@ -669,14 +686,7 @@ fn rsl_plans_k_from_the_target_error() {
     let target = 0.0028;
     let c = rsl::choose_k(&small.scene, &o, target).unwrap();
     eprintln!("{c:?}");
-    let e: Vec<f64> = c.estimates.iter().map(|x| x.1).collect();
-    assert!(e.windows(2).all(|w| w[1] <= w[0]), "{e:?}");
-    let first = c
-        .estimates
-        .iter()
-        .find(|x| x.1 <= scene::PLAN_SHARE * target)
-        .unwrap();
-    assert_eq!(first.0, c.k);
+    assert_choice(&c.estimates, c.k, target);
     let loose = rsl::choose_k(&small.scene, &o, 0.05).unwrap();
     assert!(loose.k < c.k, "{loose:?}");
     let img = rsl::render(
@@ -736,12 +746,7 @@ fn lobes_plans_the_quadtree_depth_from_the_target_error() {
         let c = lobes::choose_depth(&small.scene, &planned, target);
         eprintln!("{name}: {c:?}");
         assert_eq!(c.estimates.last(), Some(&(MAX_DEPTH, 0.0)));
-        let first = c
-            .estimates
-            .iter()
-            .find(|x| x.1 <= scene::PLAN_SHARE * target)
-            .unwrap();
-        assert_eq!(first.0, c.depth);
+        assert_choice(&c.estimates, c.depth, target);
         assert!(c.depth < MAX_DEPTH, "{name}: {c:?}");
         let lobes::Visibility::Mask { depth, .. } = planned.visibility else {
             panic!("the plan uses the mask")
@@ -800,14 +805,8 @@ fn hvl_plans_the_hvl_count_from_the_target_error() {
     eprintln!("{c:?}");
     let last = *hvl::SIDE_CANDIDATES.last().unwrap();
     assert_eq!(c.estimates.last(), Some(&(last, 0.0)));
-    let e: Vec<f64> = c.estimates.iter().map(|x| x.1).collect();
-    assert!(e.windows(2).all(|w| w[1] <= w[0]), "{e:?}");
-    let first = c
-        .estimates
-        .iter()
-        .find(|x| x.1 <= scene::PLAN_SHARE * target)
-        .unwrap();
-    assert_eq!((first.0, planned.side), (c.side, c.side));
+    assert_choice(&c.estimates, c.side, target);
+    assert_eq!(planned.side, c.side);
     let loose = plan_at(&small.scene, render::Method::Hvl, 0.02).hvl;
     assert!(loose.side < planned.side, "{loose:?}");
     assert_eq!(

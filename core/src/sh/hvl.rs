@@ -248,23 +248,11 @@ pub fn contribution(
     let n = crate::sh::bands_of(rx.coeffs.len())?;
     let ne = crate::sh::bands_of(emission.len())?;
     crate::sh::check_shape(n.max(ne), scratch.len())?;
-    let (emit_dir, cap_axis, half_angle, power, g) =
-        match prepare(hvl, rx.point, &rx.frame, horizon) {
-            Prepared::Value(v) => return Ok(v),
-            Prepared::Lit {
-                emit_dir,
-                cap_axis,
-                half_angle,
-                power,
-                g,
-            } => (emit_dir, cap_axis, half_angle, power, g),
+    let (e, cap_axis, half_angle, power, g) =
+        match lit(hvl, emission, ne, rx.point, &rx.frame, horizon, scratch)? {
+            Ok(lit) => lit,
+            Err(v) => return Ok(v),
         };
-    // Emission toward x: F′·Y(−ω_j) in the HVL's frame.
-    eval_into(emit_dir, ne, scratch)?;
-    let mut e = 0.0f32;
-    for (a, y) in emission.iter().zip(scratch.iter()) {
-        e += a * y;
-    }
     // The cap in the receiver's frame, dotted with F.
     cap::coefficients_into(cap_axis, half_angle, n, scratch)?;
     let mut sum = 0.0f32;
@@ -272,6 +260,38 @@ pub fn contribution(
         sum += f * c;
     }
     Ok(power * e * g * sum)
+}
+
+/// What both contribution kernels share: the geometry ([`prepare`]) and the emission toward
+/// the receiver, `e = Σ F′_k·Y_k(−ω_j)` in the HVL's frame (index order from `+0`, `f32`):
+/// `Ok((e, cap axis, half-angle, P, G))`, or `Err(value)` when the geometry settles the
+/// contribution.
+#[allow(clippy::type_complexity)]
+fn lit(
+    hvl: &Hvl,
+    emission: &[f32],
+    ne: usize,
+    point: Vec3,
+    frame: &Frame,
+    horizon: Horizon,
+    scratch: &mut [f32],
+) -> Result<Result<(f32, Vec3, f32, f32, f32), f32>, Error> {
+    let (emit_dir, cap_axis, half_angle, power, g) = match prepare(hvl, point, frame, horizon) {
+        Prepared::Value(v) => return Ok(Err(v)),
+        Prepared::Lit {
+            emit_dir,
+            cap_axis,
+            half_angle,
+            power,
+            g,
+        } => (emit_dir, cap_axis, half_angle, power, g),
+    };
+    eval_into(emit_dir, ne, scratch)?;
+    let mut e = 0.0f32;
+    for (a, y) in emission.iter().zip(scratch.iter()) {
+        e += a * y;
+    }
+    Ok(Ok((e, cap_axis, half_angle, power, g)))
 }
 
 /// A receiver whose coefficients are zonal around its normal, `F_l = F_l^0` (`l < n`), in
@@ -314,22 +334,11 @@ pub fn contribution_zonal(
             max: f32::INFINITY,
         });
     }
-    let (emit_dir, cap_axis, half_angle, power, g) =
-        match prepare(hvl, rx.point, &rx.frame, horizon) {
-            Prepared::Value(v) => return Ok(v),
-            Prepared::Lit {
-                emit_dir,
-                cap_axis,
-                half_angle,
-                power,
-                g,
-            } => (emit_dir, cap_axis, half_angle, power, g),
+    let (e, cap_axis, half_angle, power, g) =
+        match lit(hvl, emission, ne, rx.point, &rx.frame, horizon, scratch)? {
+            Ok(lit) => lit,
+            Err(v) => return Ok(v),
         };
-    eval_into(emit_dir, ne, scratch)?;
-    let mut e = 0.0f32;
-    for (a, y) in emission.iter().zip(scratch.iter()) {
-        e += a * y;
-    }
     crate::sh::eval_zonal_into(cap_axis, n, scratch)?;
     let mut sum = 0.0f32;
     cap::band_scales(half_angle, n, |l, k| {

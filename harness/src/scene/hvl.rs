@@ -268,15 +268,8 @@ pub fn choose_side(scene: &Scene, o: &Options, target: f64) -> SideChoice {
                 .collect()
         })
         .collect();
-    let estimates: Vec<(usize, f64)> = SIDE_CANDIDATES
-        .iter()
-        .copied()
-        .zip(super::probe_estimates(&images))
-        .collect();
-    let side = estimates
-        .iter()
-        .find(|&&(_, e)| e <= super::PLAN_SHARE * target)
-        .map_or(SIDE_CANDIDATES[SIDE_CANDIDATES.len() - 1], |&(s, _)| s);
+    let (side, estimates) = super::plan_choice(&SIDE_CANDIDATES, &images, target)
+        .unwrap_or((SIDE_CANDIDATES[0], Vec::new()));
     SideChoice { side, estimates }
 }
 

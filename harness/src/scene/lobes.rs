@@ -228,15 +228,8 @@ pub fn choose_depth(scene: &Scene, o: &Options, target: f64) -> DepthChoice {
                 .collect()
         })
         .collect();
-    let estimates: Vec<(u32, f64)> = depths
-        .iter()
-        .copied()
-        .zip(super::probe_estimates(&images))
-        .collect();
-    let depth = estimates
-        .iter()
-        .find(|&&(_, e)| e <= super::PLAN_SHARE * target)
-        .map_or(mask::MAX_DEPTH, |&(d, _)| d);
+    let (depth, estimates) =
+        super::plan_choice(&depths, &images, target).unwrap_or((mask::MAX_DEPTH, Vec::new()));
     DepthChoice { depth, estimates }
 }
 

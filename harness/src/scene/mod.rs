@@ -376,6 +376,28 @@ pub fn probe_points(scene: &Scene) -> Vec<ShadingPoint> {
     out
 }
 
+/// A plan's choice among `candidates` (cheapest first), each with its shaded probes in
+/// `shaded` (the same order): the estimates of [`probe_estimates`] beside their candidates,
+/// and the first candidate within [`PLAN_SHARE`] of `target`, or the last (the finest) when
+/// none is. `None` without candidates.
+pub fn plan_choice<T: Copy>(
+    candidates: &[T],
+    shaded: &[Vec<Rgb>],
+    target: f64,
+) -> Option<(T, Vec<(T, f64)>)> {
+    let last = *candidates.last()?;
+    let estimates: Vec<(T, f64)> = candidates
+        .iter()
+        .copied()
+        .zip(probe_estimates(shaded))
+        .collect();
+    let chosen = estimates
+        .iter()
+        .find(|&&(_, e)| e <= PLAN_SHARE * target)
+        .map_or(last, |&(c, _)| c);
+    Some((chosen, estimates))
+}
+
 /// The plans' error estimate: for each candidate's shaded probes (the last candidate the
 /// finest), the mean |difference| from the last over the last's largest value — the
 /// render's measure (mean |difference| over the maximum radiance) with the finest

@@ -147,6 +147,15 @@ fn kernel_name(o: &Options) -> &'static str {
     }
 }
 
+/// A plan's estimates as text: `"{name}{candidate}: {estimate}"`, comma-separated.
+fn estimates_text<T: std::fmt::Display>(name: &str, estimates: &[(T, f64)]) -> String {
+    estimates
+        .iter()
+        .map(|(c, e)| format!("{name}{c}: {e:.1e}"))
+        .collect::<Vec<_>>()
+        .join(", ")
+}
+
 /// The plan of a method for a scene: what it builds and why.
 pub fn plan(scene: &Scene, o: &Options) -> Result<Plan, String> {
     let mut p = Vec::new();
@@ -181,11 +190,7 @@ pub fn plan(scene: &Scene, o: &Options) -> Result<Plan, String> {
             r.vis_depth = super::rsl::coverage_depth_for(o.target_error);
             let choice = super::rsl::choose_k(scene, &r, o.target_error)?;
             r.k = choice.k;
-            let est: Vec<String> = choice
-                .estimates
-                .iter()
-                .map(|(k, e)| format!("K = {k}: {e:.1e}"))
-                .collect();
+            let est = estimates_text("K = ", &choice.estimates);
             p.push(PlanItem {
                 item: "rsls".into(),
                 value: json!(r.k),
@@ -198,7 +203,7 @@ pub fn plan(scene: &Scene, o: &Options) -> Result<Plan, String> {
                     super::PROBES.0 * super::PROBES.1,
                     super::PLAN_SHARE,
                     o.target_error,
-                    est.join(", ")
+                    est
                 ),
             });
             p.push(PlanItem {
@@ -302,11 +307,7 @@ pub fn plan(scene: &Scene, o: &Options) -> Result<Plan, String> {
                     leaves,
                 };
             }
-            let est: Vec<String> = choice
-                .estimates
-                .iter()
-                .map(|(d, e)| format!("depth {d}: {e:.1e}"))
-                .collect();
+            let est = estimates_text("depth ", &choice.estimates);
             p.push(PlanItem {
                 item: "visibility".into(),
                 value: json!(format!("quadtree mask, depth {}", choice.depth)),
@@ -319,18 +320,14 @@ pub fn plan(scene: &Scene, o: &Options) -> Result<Plan, String> {
                     super::PLAN_SHARE,
                     o.target_error,
                     steradian_core::lobe::mask::MAX_DEPTH,
-                    est.join(", ")
+                    est
                 ),
             });
             if o.method == Method::Hvl {
                 hv.direct = lo;
                 let choice = super::hvl::choose_side(scene, &hv, o.target_error);
                 hv.side = choice.side;
-                let est: Vec<String> = choice
-                    .estimates
-                    .iter()
-                    .map(|(side, e)| format!("side {side}: {e:.1e}"))
-                    .collect();
+                let est = estimates_text("side ", &choice.estimates);
                 p.push(PlanItem {
                     item: "hvls".into(),
                     value: json!(6 * hv.side * hv.side * scene.lights.len()),
@@ -343,7 +340,7 @@ pub fn plan(scene: &Scene, o: &Options) -> Result<Plan, String> {
                         super::PROBES.0 * super::PROBES.1,
                         super::PLAN_SHARE,
                         o.target_error,
-                        est.join(", ")
+                        est
                     ),
                 });
                 p.push(PlanItem {

@@ -210,22 +210,10 @@ pub fn choose_k(scene: &Scene, o: &Options, target: f64) -> Result<KChoice, Stri
             (k, img)
         })
         .collect();
-    if shaded.is_empty() {
-        return Err("no candidate K fits the cube map".into());
-    }
     let (order, images): (Vec<usize>, Vec<Vec<Rgb>>) = shaded.into_iter().unzip();
-    let estimates: Vec<(usize, f64)> = order
-        .into_iter()
-        .zip(super::probe_estimates(&images))
-        .collect();
-    let chosen = estimates
-        .iter()
-        .find(|&&(_, e)| e <= super::PLAN_SHARE * target)
-        .map(|&(k, _)| k);
-    Ok(KChoice {
-        k: chosen.unwrap_or(ks[ks.len() - 1]),
-        estimates,
-    })
+    let (k, estimates) =
+        super::plan_choice(&order, &images, target).ok_or("no candidate K fits the cube map")?;
+    Ok(KChoice { k, estimates })
 }
 
 /// The visibility moment tables of a surface point (module docs), `None` where the point
