@@ -163,8 +163,7 @@ impl Default for Scratch {
 /// diffuse part, whose Lambert coefficients are zonal in its view frame (the table's
 /// `m ≠ 0` entries are below `1e-6` of `F_0^0`, asserted in core), so each HVL goes through
 /// [`core_hvl::contribution_zonal`] with the `m = 0` entries: `n` basis values per HVL
-/// instead of `n²` (the full kernel on the same point: 1.57 s against 1.21 s for `room` at
-/// 320 columns).
+/// instead of `n²`.
 pub fn indirect(
     scene: &Scene,
     p: &ShadingPoint,
@@ -240,8 +239,8 @@ pub struct SideChoice {
 }
 
 /// The smallest face side of [`SIDE_CANDIDATES`] whose HVLs keep the shaded probes within
-/// [`super::PLAN_SHARE`] of `target` (mean |difference| over the maximum radiance, the render's measure) of
-/// the largest candidate's. The probes are the [`super::probe_points`] grid; each is lit by
+/// [`super::PLAN_SHARE`] of `target` (mean |difference| over the maximum radiance, the
+/// render's measure) of the largest candidate's. The probes are the [`super::probe_points`] grid; each is lit by
 /// the same direct light (`o.direct`) for every side, so the difference is the HVL count's
 /// alone, and the largest value includes the direct light as the render's does. The rest
 /// of the target is left to the direct light and to the HVL approximation itself. The

@@ -201,10 +201,10 @@ pub struct DepthChoice {
 }
 
 /// The shallowest quadtree mask (levels `1 ..= mask::MAX_DEPTH`) that keeps the shaded
-/// probes within [`super::PLAN_SHARE`] of `target` (mean |difference| over the maximum radiance,
-/// the render's measure) of the deepest mask's: the probes are the [`super::probe_points`]
-/// grid, shaded with `o` but for the depth, so the difference is the depth's alone. The
-/// deepest level when `o` does not use the mask or none is within.
+/// probes within [`super::PLAN_SHARE`] of `target` (mean |difference| over the maximum
+/// radiance, the render's measure) of the deepest mask's: the probes are the
+/// [`super::probe_points`] grid, shaded with `o` but for the depth, so the difference is
+/// the depth's alone. The deepest level when `o` does not use the mask or none is within.
 pub fn choose_depth(scene: &Scene, o: &Options, target: f64) -> DepthChoice {
     let Visibility::Mask { leaves, .. } = o.visibility else {
         return DepthChoice {

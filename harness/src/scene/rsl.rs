@@ -170,12 +170,13 @@ pub struct KChoice {
 }
 
 /// The smallest `K` of [`K_CANDIDATES`] whose light decomposition alone keeps the shaded
-/// probes within [`super::PLAN_SHARE`] of `target` (mean |difference| over the maximum radiance, the
-/// render's measure) of the largest candidate's ([`super::probe_estimates`]): the probes
-/// are the [`super::probe_points`] grid, shaded with the same visibility and BRDF SATs for
-/// every `K`, so the difference is the decomposition's alone (the error that dominates
-/// `rsl` on the built-in scenes; the rest of the target is left to visibility and
-/// the SATs). The largest candidate if none is within.
+/// probes within [`super::PLAN_SHARE`] of `target` (mean |difference| over the maximum
+/// radiance, the render's measure) of the largest candidate's
+/// ([`super::probe_estimates`]): the probes are the [`super::probe_points`] grid, shaded
+/// with the same visibility and BRDF SATs for every `K`, so the difference is the
+/// decomposition's alone (the error that dominates `rsl` on the built-in scenes; the rest
+/// of the target is left to visibility and the SATs). The largest candidate if none is
+/// within.
 pub fn choose_k(scene: &Scene, o: &Options, target: f64) -> Result<KChoice, String> {
     let texels = 6 * o.face * o.face;
     let ks: Vec<usize> = K_CANDIDATES
