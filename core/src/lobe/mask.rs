@@ -93,7 +93,7 @@ pub fn weight(table: &[f32], dist: f32, depth: u32) -> f32 {
 struct Occ {
     axis: Vec3,
     cos_b: f32,
-    half_angle: f32,
+    sin_b: f32,
 }
 
 /// The square's frame and extent for one light.
@@ -103,7 +103,7 @@ struct Square {
     t: Vec3,
     b: Vec3,
     cos_a: f32,
-    half_angle: f32,
+    sin_a: f32,
 }
 
 impl Square {
@@ -132,14 +132,14 @@ pub fn shadow_leaves(
         t: Vec3::new(1.0 + sign * h.x * h.x * a, sign * bb, -sign * h.x),
         b: Vec3::new(bb, sign + h.y * h.y * a, -h.y),
         cos_a: math::cosf(light.half_angle()),
-        half_angle: light.half_angle(),
+        sin_a: math::sinf(light.half_angle()),
     };
     // Beyond 80° the square's corners are near the horizon of the point: clamp.
-    let tan_a = (math::sinf(light.half_angle()) / sq.cos_a.max(0.17)).min(5.7);
+    let tan_a = (sq.sin_a / sq.cos_a.max(0.17)).min(5.7);
     let mut occ = [Occ {
         axis: Vec3::Z,
         cos_b: 1.0,
-        half_angle: 0.0,
+        sin_b: 0.0,
     }; 64];
     let mut n = 0;
     for o in occluders {
@@ -149,7 +149,7 @@ pub fn shadow_leaves(
         occ[n] = Occ {
             axis: o.axis(),
             cos_b: math::cosf(o.half_angle()),
-            half_angle: o.half_angle(),
+            sin_b: math::sinf(o.half_angle()),
         };
         n += 1;
     }
@@ -169,8 +169,14 @@ pub fn shadow_leaves(
     count
 }
 
-fn angle_between(a: Vec3, b: Vec3) -> f32 {
-    math::acosf(a.dot(b).clamp(-1.0, 1.0))
+/// `θ > α + γ` for `θ = ∠(u, v)` (unit vectors), given `cos α`, `sin α`, `cos γ`, `sin γ` of
+/// two angles in `[0, π]`: where `α + γ < π` (`cos γ > −cos α`) it is
+/// `u·v < cos(α + γ) = cos α·cos γ − sin α·sin γ` (cosine falls on `[0, π]`), and false
+/// otherwise (no angle exceeds `π`). Trigonometry-free, where the cell tests of [`visit`]
+/// took one `acos` per comparison.
+#[inline]
+fn beyond(uv: f32, (cos_a, sin_a): (f32, f32), (cos_g, sin_g): (f32, f32)) -> bool {
+    cos_g > -cos_a && uv.clamp(-1.0, 1.0) < cos_a * cos_g - sin_a * sin_g
 }
 
 fn visit(
@@ -189,12 +195,15 @@ fn visit(
         sq.dir(p - s, q + s),
         sq.dir(p + s, q + s),
     ];
-    let gamma = corners
+    // γ, the cell's angular radius about its centre: the largest corner angle, i.e. the
+    // smallest cosine.
+    let cos_g = corners
         .iter()
-        .map(|c| angle_between(*c, centre))
-        .fold(0.0f32, f32::max);
-    // Wholly outside the light's cap: not considered.
-    if angle_between(centre, sq.h) - gamma > sq.half_angle {
+        .map(|c| c.dot(centre).clamp(-1.0, 1.0))
+        .fold(1.0f32, f32::min);
+    let g = (cos_g, math::sqrtf((1.0 - cos_g * cos_g).max(0.0)));
+    // Wholly outside the light's cap (∠(centre, h) > α + γ): not considered.
+    if beyond(centre.dot(sq.h), (sq.cos_a, sq.sin_a), g) {
         return;
     }
     let mut touched = false;
@@ -203,7 +212,8 @@ fn visit(
             emit(sq, (p, q, s), depth, leaf);
             return;
         }
-        if angle_between(o.axis, centre) <= o.half_angle + gamma {
+        // Within reach of the occluder's cap: ∠(axis, centre) ≤ β + γ.
+        if !beyond(o.axis.dot(centre), (o.cos_b, o.sin_b), g) {
             touched = true;
         }
     }
