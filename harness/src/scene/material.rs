@@ -398,21 +398,13 @@ fn ggx_d(c: f64, alpha: f64) -> f64 {
     a2 / (PI * t * t)
 }
 
-/// `D·G₁(ωi)G₁(ωo)·F/(4 cos θi cos θo)` with `G₁(c) = 2c/(c + √(α² + (1 − α²)c²))` and
-/// Schlick's `F = f0 + (1 − f0)(1 − ωi·h)⁵`, so the fraction is
-/// `D·F/((ci + si)(co + so))`, `s = √(α² + (1 − α²)c²)`: core's `Ggx`, in `f64`.
+/// The GGX microfacet term (no diffuse, no cosine) of the f64 reference model
+/// (`steradian_reference::lobe::brdf::Model::Ggx`: GGX `D`, separable Smith `G₁`,
+/// Schlick's `F`, the formula of core's `Ggx`), with `ωi`, `ωo` taken into the frame of `n`.
 fn ggx_specular(n: DVec3, wo: DVec3, wi: DVec3, f0: f64, alpha: f64) -> f64 {
-    let (ci, co) = (n.dot(wi), n.dot(wo));
-    if ci <= 0.0 || co <= 0.0 {
-        return 0.0;
-    }
-    let h = (wi + wo).normalize();
-    let a2 = alpha * alpha;
-    let si = (a2 + (1.0 - a2) * ci * ci).sqrt();
-    let so = (a2 + (1.0 - a2) * co * co).sqrt();
-    let m = 1.0 - wi.dot(h).clamp(0.0, 1.0);
-    let f = f0 + (1.0 - f0) * m.powi(5);
-    ggx_d(n.dot(h), alpha) * f / ((ci + si) * (co + so))
+    let (t, b) = basis(n);
+    let local = |v: DVec3| [v.dot(t), v.dot(b), v.dot(n)];
+    steradian_reference::lobe::brdf::Model::Ggx { kd: 0.0, f0, alpha }.rho(local(wi), local(wo))
 }
 
 /// A microfacet normal with density `D(h)·(n·h)`: `tan²θ = α²u/(1 − u)` (inverting the
