@@ -68,7 +68,9 @@ fn special_values_in_every_component_and_lane() {
 fn many_bands_and_the_x4_entry_point() {
     let mut rng = Rng(7);
     let dirs: [Vec3; 4] = core::array::from_fn(|_| rng.dir());
-    for bands in [1usize, 8, MAX_BANDS] {
+    // Every band count with generated straight-line code (2–10), its neighbours, and the
+    // loop beyond.
+    for bands in (1usize..=11).chain([MAX_BANDS]) {
         let mut out = vec![[0.0f32; 4]; bands * bands];
         eval_x4(dirs, bands, &mut out).expect("valid band count");
         for (lane, d) in dirs.iter().enumerate() {
@@ -90,7 +92,7 @@ fn the_x8_entry_point_every_lane_with_special_values() {
     dirs[5] = Vec3::new(f32::NAN, 0.0, 1.0);
     dirs[6] = Vec3::new(1e-45, 0.0, -1e-45);
     dirs[7] = -Vec3::Z;
-    for bands in [1usize, 3, 8, 30, MAX_BANDS] {
+    for bands in (1usize..=11).chain([30, MAX_BANDS]) {
         let mut out = vec![[0.0f32; 8]; bands * bands];
         eval_x8(dirs, bands, &mut out).expect("valid band count");
         for (lane, d) in dirs.iter().enumerate() {
