@@ -265,6 +265,34 @@ fn emit(
 mod tests {
     use super::*;
 
+    /// `beyond` is the angle comparison `θ > α + γ` it replaces, on a grid of angles
+    /// covering `[0, π]` each (sums past `π` included), wherever the two sides are more
+    /// than `1e-5` rad apart (within that the `f32` roundings of either form decide).
+    #[test]
+    fn beyond_is_the_angle_comparison() {
+        let steps = 60;
+        let at = |i: usize| crate::PI * i as f32 / steps as f32;
+        let mut decided = 0;
+        for i in 0..=steps {
+            for j in 0..=steps {
+                for k in 0..=steps {
+                    let (t, a, g) = (at(i), at(j), at(k));
+                    if (f64::from(t) - f64::from(a) - f64::from(g)).abs() < 1e-5 {
+                        continue;
+                    }
+                    let sc = |x: f32| (math::cosf(x), math::sinf(x));
+                    assert_eq!(
+                        beyond(math::cosf(t), sc(a), sc(g)),
+                        t > a + g,
+                        "θ {t} α {a} γ {g}"
+                    );
+                    decided += 1;
+                }
+            }
+        }
+        assert!(decided > 200_000, "{decided}");
+    }
+
     #[test]
     fn dist_is_the_circumscribing_distance() {
         // Half-side ½ at distance dist subtends tan α = ½/dist.

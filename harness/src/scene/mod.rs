@@ -400,8 +400,7 @@ pub fn plan_choice<T: Copy>(
 /// The plans' error estimate: for each candidate's shaded probes (the last candidate the
 /// finest), the mean |difference| from the last over the last's largest value — the
 /// render's measure (mean |difference| over the maximum radiance) with the finest
-/// candidate standing in for the reference. A candidate of another length than the last
-/// (which the callers never pass) is `∞`.
+/// candidate standing in for the reference (every candidate shaded at the same probes).
 pub fn probe_estimates(shaded: &[Vec<Rgb>]) -> Vec<f64> {
     let Some(reference) = shaded.last() else {
         return Vec::new();
@@ -413,9 +412,6 @@ pub fn probe_estimates(shaded: &[Vec<Rgb>]) -> Vec<f64> {
     shaded
         .iter()
         .map(|img| {
-            if img.len() != reference.len() {
-                return f64::INFINITY;
-            }
             let n = (3 * img.len()).max(1) as f64;
             let sum: f64 = img
                 .iter()
