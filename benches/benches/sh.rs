@@ -62,8 +62,8 @@ fn eval(c: &mut Criterion) {
     g.finish();
 }
 
-/// Rotation per vector: the ZXZXZ path and the built operator's application, at 3, 5, 10
-/// and 30 bands, and the operator's build (what a batch sharing one rotation pays once).
+/// Rotation per vector: the ZXZXZ path (scalar and SIMD) and the built operator's
+/// application, at 3, 5, 10 and 30 bands, and the operator's build (what a batch sharing one rotation pays once).
 fn rotation(c: &mut Criterion) {
     use steradian_core::sh::rotate::{Operator, Rotation, Rotator};
     let rot = Rotation::from_axis_angle(Vec3::new(0.3, -0.5, 0.8), 1.1).unwrap();
@@ -78,6 +78,24 @@ fn rotation(c: &mut Criterion) {
         g.bench_with_input(BenchmarkId::new("zxzxz", bands), &bands, |b, _| {
             b.iter(|| rz.rotate(&rot, black_box(&input), &mut out).unwrap())
         });
+        // The SIMD twin on 64 vectors, each with its rotation (throughput per vector).
+        let many: Vec<f32> = (0..64).flat_map(|_| input.iter().copied()).collect();
+        let mut many_out = vec![0.0f32; many.len()];
+        let rots = vec![rot; 64];
+        g.throughput(Throughput::Elements(64));
+        g.bench_with_input(BenchmarkId::new("zxzxz simd", bands), &bands, |b, &n| {
+            b.iter(|| {
+                steradian_simd::sh::rotate::rotate_zxzxz_slices(
+                    rz.table(),
+                    &rots,
+                    n,
+                    black_box(&many),
+                    &mut many_out,
+                )
+                .unwrap()
+            })
+        });
+        g.throughput(Throughput::Elements(1));
         let op = Operator::new(&rot, bands).unwrap();
         g.bench_with_input(BenchmarkId::new("operator apply", bands), &bands, |b, _| {
             b.iter(|| op.apply(black_box(&input), &mut out).unwrap())

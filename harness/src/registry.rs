@@ -411,10 +411,9 @@ pub const KERNELS: &[KernelSpec] = &[
         contract: r#"{"coeffs": [n² values], "rotation": [[r00,r01,r02],[r10,r11,r12],[r20,r21,r22]] rows, max|RᵀR−I| ≤ 1e-5, det > 0} -> {"coeffs": [n² values of g(ω) = f(Rᵀω)]}"#,
         eval: Piece::At(handlers::sh_rotate),
         scalar: "steradian_core::sh::rotate::rotate_zxzxz",
-        simd: Piece::Without(
-            "the ZXZXZ path has none; the built operator's twin (8 vectors per pass, \
-             bit-identical) is steradian_simd::sh::rotate::apply_operator_slices",
-        ),
+        // Four vectors per pass, each with its own rotation; the built operator's twin (one
+        // rotation, eight vectors per pass) is steradian_simd::sh::rotate::apply_operator_slices.
+        simd: Piece::At("steradian_simd::sh::rotate::rotate_zxzxz_slices"),
         // The twin of the scalar ZXZXZ path (each row its own rotation); the built
         // operator's twin, `wgsl::SH_ROTATE` (one rotation for every row), is also listed
         // under this name in `wgsl::CUSTOM`.

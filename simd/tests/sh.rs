@@ -199,6 +199,118 @@ fn rotation_operator_lanes_equal_the_scalar_kernel() {
     );
 }
 
+/// `rotate_zxzxz_slices` on `vectors` with their rotations against the scalar
+/// `rotate_zxzxz`, bit for bit, every coefficient of every vector.
+fn check_zxzxz(x90: &[f32], rots: &[sh::rotate::Rotation], bands: usize, vectors: &[Vec<f32>]) {
+    let nn = bands * bands;
+    let input: Vec<f32> = vectors.concat();
+    let mut out = vec![0.0f32; input.len()];
+    steradian_simd::sh::rotate::rotate_zxzxz_slices(x90, rots, bands, &input, &mut out)
+        .expect("valid shapes");
+    let mut want = vec![0.0f32; nn];
+    for (v, x) in vectors.iter().enumerate() {
+        sh::rotate::rotate_zxzxz(x90, &rots[v], bands, x, &mut want).expect("valid shapes");
+        for (k, w) in want.iter().enumerate() {
+            let got = out[v * nn + k];
+            assert!(
+                same(got, *w),
+                "bands {bands} vector {v} coefficient {k}: {got} vs {w}"
+            );
+        }
+    }
+}
+
+/// Rotations of every path of the scalar kernel: general ones, about `z` (the identity
+/// included), half-turns about horizontal axes, and the near-singular Euler angles.
+fn every_kind_of_rotation(rng: &mut Rng) -> Vec<sh::rotate::Rotation> {
+    use sh::rotate::Rotation;
+    let axis_angle = |a: Vec3, t: f32| Rotation::from_axis_angle(a, t).unwrap();
+    let mut rots = vec![
+        Rotation::identity(),
+        axis_angle(Vec3::Z, 0.7),
+        axis_angle(-Vec3::Z, 3.0),
+        axis_angle(Vec3::X, core::f32::consts::PI),
+        axis_angle(Vec3::new(1.0, 1.0, 0.0), core::f32::consts::PI),
+        axis_angle(Vec3::X, 1e-6),
+        axis_angle(Vec3::new(0.0, 1.0, 1e-6), 2.0),
+        axis_angle(Vec3::Y, core::f32::consts::PI - 1e-6),
+    ];
+    for _ in 0..16 {
+        rots.push(axis_angle(rng.dir(), rng.range(-3.2, 3.2)));
+    }
+    rots
+}
+
+#[test]
+fn zxzxz_lanes_equal_the_scalar_kernel() {
+    let mut rng = Rng(0x2a2a);
+    let kinds = every_kind_of_rotation(&mut rng);
+    for bands in [0usize, 1, 2, 3, 5, 10, 12, 30] {
+        let nn = bands * bands;
+        let mut x90_table = vec![0.0f32; sh::rotate::operator_len(bands)];
+        let mut scratch = vec![0.0f64; sh::rotate::scratch_len(bands)];
+        sh::rotate::x90_into(bands, &mut x90_table, &mut scratch).unwrap();
+        for &len in &LENGTHS {
+            let len = len.min(60);
+            let vectors: Vec<Vec<f32>> = (0..len)
+                .map(|_| (0..nn).map(|_| rng.range(-2.0, 2.0)).collect())
+                .collect();
+            // Rotations of every kind in every lane position, mixed within a pass.
+            let rots: Vec<_> = (0..len)
+                .map(|v| kinds[(v * 7 + len) % kinds.len()])
+                .collect();
+            check_zxzxz(&x90_table, &rots, bands, &vectors);
+            // All lanes of one kind: the passes that skip a path.
+            for kind in [0usize, 3, 8] {
+                check_zxzxz(&x90_table, &vec![kinds[kind]; len], bands, &vectors);
+            }
+        }
+        // Special values in one coefficient of one vector, in every lane position, under a
+        // general rotation and an exact one: the lane matches the scalar kernel and the
+        // others are untouched.
+        if nn > 0 {
+            let base: Vec<f32> = (0..nn).map(|k| (k as f32 * 0.37).sin()).collect();
+            for &sp in SPECIALS.iter() {
+                let mut odd = base.clone();
+                odd[nn / 2] = sp;
+                for shift in 0..4 {
+                    let mut rows = vec![base.clone(); shift];
+                    rows.push(odd.clone());
+                    rows.push(base.clone());
+                    for rot in [kinds[9], kinds[3]] {
+                        check_zxzxz(&x90_table, &vec![rot; rows.len()], bands, &rows);
+                    }
+                }
+            }
+        }
+    }
+}
+
+#[test]
+fn zxzxz_shapes_are_errors() {
+    use sh::rotate::Rotation;
+    use steradian_simd::sh::rotate::{rotate_zxzxz_slices, rotate_zxzxz_x4};
+    let mut x90 = vec![0.0f32; sh::rotate::operator_len(3)];
+    let mut scratch = vec![0.0f64; sh::rotate::scratch_len(3)];
+    sh::rotate::x90_into(3, &mut x90, &mut scratch).unwrap();
+    let general = Rotation::from_axis_angle(Vec3::new(0.3, -0.5, 0.8), 1.1).unwrap();
+    let about_z = Rotation::from_axis_angle(Vec3::Z, 1.1).unwrap();
+    let mut out = vec![0.0f32; 18];
+    // Not a whole number of vectors; out of another length; a rotation short.
+    assert!(rotate_zxzxz_slices(&x90, &[general; 2], 3, &[0.0; 17], &mut out[..17]).is_err());
+    assert!(rotate_zxzxz_slices(&x90, &[general; 2], 3, &[0.0; 18], &mut out[..9]).is_err());
+    assert!(rotate_zxzxz_slices(&x90, &[general; 1], 3, &[0.0; 18], &mut out).is_err());
+    // A short table is an error only where a rotation needs it, as in the scalar kernel.
+    assert!(rotate_zxzxz_slices(&x90[..10], &[general; 2], 3, &[0.0; 18], &mut out).is_err());
+    assert!(rotate_zxzxz_slices(&x90[..10], &[about_z; 2], 3, &[0.0; 18], &mut out).is_ok());
+    assert!(rotate_zxzxz_slices(&x90, &[general; 1], MAX_BANDS + 1, &[], &mut []).is_err());
+    let mut short = vec![[0.0f32; 4]; 8];
+    assert!(rotate_zxzxz_x4(&x90, [&general; 4], 3, &[[0.0; 4]; 9], &mut short).is_err());
+    let mut lanes = vec![[0.0f32; 4]; 9];
+    assert!(rotate_zxzxz_x4(&x90[..10], [&general; 4], 3, &[[0.0; 4]; 9], &mut lanes).is_err());
+    assert!(rotate_zxzxz_x4(&x90[..10], [&about_z; 4], 3, &[[0.0; 4]; 9], &mut lanes).is_ok());
+}
+
 /// `coefficients_slices` on caps `(axis, half-angle)` against the scalar
 /// `coefficients_into`, bit for bit, every coefficient of every cap.
 fn check_caps(caps: &[(Vec3, f32)], bands: usize) {

@@ -85,9 +85,10 @@ pub fn rotate_rel_error(bands: usize) -> f32 {
     1.0e-7 + 1.0e-8 * bands as f32
 }
 
-/// What the fast path does for a rotation (module docs, "Euler angles").
+/// What the fast path does for a rotation (module docs, "Euler angles"): read by the SIMD
+/// twin through [`Rotation::euler`].
 #[derive(Clone, Copy, Debug, PartialEq)]
-enum Euler {
+pub enum Euler {
     /// `Z(θ)` alone: a rotation about `z` (`(cos θ, sin θ)`).
     AboutZ([f64; 2]),
     /// `Z(θ)·M(Ry(π))`: a half-turn about a horizontal axis.
@@ -179,6 +180,11 @@ impl Rotation {
             });
         }
         Self::from_dmat3(DMat3::from_axis_angle(a / len, angle.into()))
+    }
+
+    /// The Euler decomposition [`rotate_zxzxz`] applies (module docs), with its exact cases.
+    pub fn euler(&self) -> Euler {
+        self.euler
     }
 
     /// The exact (orthogonalised) matrix.
@@ -450,7 +456,8 @@ fn rotate_z(l: usize, cs: [f64; 2], band: &mut [f64]) {
     }
 }
 
-/// `y = J·x` (`transpose = false`) or `Jᵀ·x` for one band's block.
+/// `y = J·x` (`transpose = false`) or `Jᵀ·x` for one band's block. Each output sums its
+/// products in input order from `+0`, unfused: the order the SIMD twin repeats per lane.
 fn apply_block(block: &[f32], w: usize, transpose: bool, x: &[f64], y: &mut [f64]) {
     if transpose {
         y[..w].fill(0.0);
@@ -461,11 +468,11 @@ fn apply_block(block: &[f32], w: usize, transpose: bool, x: &[f64], y: &mut [f64
         }
     } else {
         for (i, yi) in y[..w].iter_mut().enumerate() {
-            *yi = block[i * w..i * w + w]
-                .iter()
-                .zip(&x[..w])
-                .map(|(&a, &b)| f64::from(a) * b)
-                .sum();
+            let mut acc = 0.0f64;
+            for (&a, &b) in block[i * w..i * w + w].iter().zip(&x[..w]) {
+                acc += f64::from(a) * b;
+            }
+            *yi = acc;
         }
     }
 }
@@ -579,6 +586,11 @@ impl Rotator {
     /// The largest band count the table covers.
     pub fn bands(&self) -> usize {
         self.bands
+    }
+
+    /// The `J` table (layout of [`operator_into`]), for the SIMD twin.
+    pub fn table(&self) -> &[f32] {
+        &self.x90
     }
 
     /// `out = M(rot)·input` for the `n` bands of `input` (`n² = input.len()`, `n` at most

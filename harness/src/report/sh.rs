@@ -153,6 +153,7 @@ fn eval_rows(opts: &Options, gpu: &mut Option<Gpu>) -> Vec<EvalRow> {
 struct RotateRow {
     bands: usize,
     zxzxz_ns: f64,
+    simd_zxzxz_ns: f64,
     build_ns: f64,
     apply_ns: f64,
     simd_apply_ns: f64,
@@ -167,11 +168,27 @@ fn rotate_rows(opts: &Options) -> Vec<RotateRow> {
             let input: Vec<f32> = (0..n * n).map(|i| ((i * 7919) % 13) as f32 - 6.0).collect();
             let mut out = vec![0.0f32; n * n];
             let rz = rotate::Rotator::new(n).expect("bands");
-            let zx = median_time(opts.repeats, || {
-                for _ in 0..vectors {
-                    rz.rotate(&rot, black_box(&input), &mut out).expect("shape");
+            let many: Vec<f32> = (0..vectors).flat_map(|_| input.iter().copied()).collect();
+            let mut many_out = vec![0.0f32; many.len()];
+            let rots = vec![rot; vectors];
+            // The ZXZXZ path, scalar and SIMD (each vector with its rotation), in turns.
+            let zx = median_times_in_turns(opts.repeats, 2, |k| {
+                if k == 0 {
+                    for _ in 0..vectors {
+                        rz.rotate(&rot, black_box(&input), &mut out).expect("shape");
+                    }
+                    black_box(&out);
+                } else {
+                    steradian_simd::sh::rotate::rotate_zxzxz_slices(
+                        rz.table(),
+                        &rots,
+                        n,
+                        black_box(&many),
+                        &mut many_out,
+                    )
+                    .expect("shape");
+                    black_box(&many_out);
                 }
-                black_box(&out);
             });
             let build = median_time(opts.repeats, || {
                 black_box(rotate::Operator::new(&rot, n).expect("bands"));
@@ -183,8 +200,6 @@ fn rotate_rows(opts: &Options) -> Vec<RotateRow> {
                 }
                 black_box(&out);
             });
-            let many: Vec<f32> = (0..vectors).flat_map(|_| input.iter().copied()).collect();
-            let mut many_out = vec![0.0f32; many.len()];
             let simd = median_time(opts.repeats, || {
                 steradian_simd::sh::rotate::apply_operator_slices(
                     op.blocks(),
@@ -197,7 +212,8 @@ fn rotate_rows(opts: &Options) -> Vec<RotateRow> {
             });
             RotateRow {
                 bands: n,
-                zxzxz_ns: ns_per(vectors, zx),
+                zxzxz_ns: ns_per(vectors, zx[0]),
+                simd_zxzxz_ns: ns_per(vectors, zx[1]),
                 build_ns: build.as_secs_f64() * 1e9,
                 apply_ns: ns_per(vectors, apply),
                 simd_apply_ns: ns_per(vectors, simd),
@@ -569,14 +585,16 @@ pub fn section(opts: &Options) -> Result<Section, Box<dyn Error>> {
     }
     html.push_str("</table>");
 
-    html.push_str("<h3>Rotation</h3><table><tr><th>bands</th><th>ZXZXZ per vector (ns)</th><th>operator build (ns)</th><th>operator apply per vector (ns)</th><th>SIMD operator apply per vector (ns)</th><th>vectors to break even</th></tr>");
+    html.push_str("<h3>Rotation</h3><table><tr><th>bands</th><th>ZXZXZ per vector (ns)</th><th>SIMD ZXZXZ per vector (ns)</th><th>SIMD / scalar ZXZXZ</th><th>operator build (ns)</th><th>operator apply per vector (ns)</th><th>SIMD operator apply per vector (ns)</th><th>vectors to break even</th></tr>");
     for r in &rot {
         let even = r.build_ns / (r.zxzxz_ns - r.apply_ns).max(1e-9);
         writeln!(
             html,
-            "<tr><td>{}</td><td>{:.0}</td><td>{:.0}</td><td>{:.0}</td><td>{:.0}</td><td>{}</td></tr>",
+            "<tr><td>{}</td><td>{:.0}</td><td>{:.0}</td><td>{:.2}×</td><td>{:.0}</td><td>{:.0}</td><td>{:.0}</td><td>{}</td></tr>",
             r.bands,
             r.zxzxz_ns,
+            r.simd_zxzxz_ns,
+            r.zxzxz_ns / r.simd_zxzxz_ns,
             r.build_ns,
             r.apply_ns,
             r.simd_apply_ns,
@@ -592,7 +610,13 @@ pub fn section(opts: &Options) -> Result<Section, Box<dyn Error>> {
         summary,
         "sh-rotate: {}",
         rot.iter()
-            .map(|r| format!("{} bands {:.0} ns (ZXZXZ)", r.bands, r.zxzxz_ns))
+            .map(|r| format!(
+                "{} bands {:.0} ns (ZXZXZ), SIMD {:.0} ns ({:.2}× scalar)",
+                r.bands,
+                r.zxzxz_ns,
+                r.simd_zxzxz_ns,
+                r.zxzxz_ns / r.simd_zxzxz_ns
+            ))
             .collect::<Vec<_>>()
             .join(", ")
     )?;
@@ -721,7 +745,7 @@ pub fn section(opts: &Options) -> Result<Section, Box<dyn Error>> {
             "identity_error": {"ours": r.identity[0], "plain_f64": r.identity[2], "sphrs": r.identity[3]},
         })).collect::<Vec<_>>(),
         "rotate": rot.iter().map(|r| json!({
-            "bands": r.bands, "zxzxz_ns": r.zxzxz_ns, "operator_build_ns": r.build_ns,
+            "bands": r.bands, "zxzxz_ns": r.zxzxz_ns, "simd_zxzxz_ns": r.simd_zxzxz_ns, "operator_build_ns": r.build_ns,
             "operator_apply_ns": r.apply_ns, "simd_operator_apply_ns": r.simd_apply_ns,
         })).collect::<Vec<_>>(),
         "cap_ns": caps.iter().map(|(n, ns, simd)| json!({"bands": n, "ns": ns, "simd_ns": simd})).collect::<Vec<_>>(),
