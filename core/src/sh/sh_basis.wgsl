@@ -1,18 +1,29 @@
 // steradian: all bands² real SH at a direction in f32 (mirrors `sh::eval_into`), the shared
 // part of the SH kernels (`sh_eval.wgsl`, `sh_cap.wgsl`, `sh_irradiance.wgsl`,
-// `sh_hvl.wgsl`): `sh_basis(d, bands)` fills `ybuf[l² + l + m]` for `bands ≤ 16`, and
-// `sh_cap_scale(a, bands)` turns that basis at a cap's axis into the cap's coefficients. The scalar kernel's
-// recurrence in f32, in its homogeneous form (`r² = x² + y² + z²` kept: an f32 unit vector
-// is a few 1e-8 off the sphere, and the Legendre coefficients amplify that; the f64 scalar
-// kernel does not see it), the direction scaled by its largest component and normalised
-// (f32 would overflow on squares of large components), the coefficients formed here by
-// `sqrt` of the same rationals; the rounding of the recurrence grows with the band (see
-// `steradian_core::wgsl::SH_EVAL_TOL`).
+// `sh_hvl.wgsl`): `sh_basis(d, bands)` fills `ybuf[l² + l + m]` for `bands ≤ 32`, and
+// `sh_cap_scale(a, bands)` turns that basis at a cap's axis into the cap's coefficients.
+//
+// Not the scalar kernel's recurrence: in f32, its three-term recurrence in l has a double
+// characteristic root at the poles (|cos θ| → 1), where rounding and the f32 error of cos θ
+// grow like l² (4.8e-5 at band 29). Here, per order m, with t = |cos θ| and u = 1 − t
+// formed without cancellation as (x² + y²)/(r(r + |z|)):
+//   g_l = P_l^m(t)/(sin^m θ · P_l^m(1)/sin^m θ) (so g_m = 1, g_{m+1} = t, g_l(1) = 1),
+//   (l + m)·g_l = (2l − 1)·t·g_{l−1} − (l − m − 1)·g_{l−2} (the Legendre recurrence divided
+//   by P_l^m(1)/P_{l−1}^m(1) = (l + m)/(l − m)), run on the differences e_l = g_l − g_{l−1}:
+//   (l + m)·e_l = (l − m − 1)·e_{l−1} − (2l − 1)·u·g_{l−1} (subtract (l + m)·g_{l−1} =
+//   ((2l − 1) − (l − m − 1))·g_{l−1}), g_l = g_{l−1} + e_l: small corrections to a value near
+//   1 at the poles, so errors add instead of growing like l².
+// The normalisation F_l^m = √((2l+1)/4π · (l+m)!/(l−m)!)/(2^m m!) (the value of the
+// normalised Π_l^m at the pole, divided by sin^m) by F_l/F_{l−1} = √((2l+1)(l+m)/((2l−1)(l−m)))
+// from F_m^m = Π_m^m (F_m/F_{m−1} = √((2m+1)/(2m))), then Y = √2·(−1)^m·F·g·C_m (S_m) with
+// C_m + i·S_m = (x + i·y)^m on the unit direction; cos θ < 0 by parity, (−1)^(l+m). The
+// direction is scaled by its largest component first (f32 would overflow on squares of
+// large components).
 
 const Y00: f32 = 0.28209479177387814;
-const SH_MAX_BANDS: u32 = 16u;
+const SH_MAX_BANDS: u32 = 32u;
 
-var<private> ybuf: array<f32, 256>;
+var<private> ybuf: array<f32, 1024>;
 
 fn sh_basis(d_in: vec3<f32>, bands: u32) {
     var d = d_in;
@@ -21,66 +32,53 @@ fn sh_basis(d_in: vec3<f32>, bands: u32) {
         d = vec3<f32>(0.0, 0.0, 1.0);
     } else {
         d = d / big;
-        d = d / sqrt(dot(d, d));
     }
-    let x = d.x;
-    let y = d.y;
-    let z = d.z;
-    let r2 = x * x + y * y + z * z;
-    if (bands == 0u) {
-        return;
-    }
-    ybuf[0] = Y00;
-    if (bands == 1u) {
-        return;
-    }
-    // m = 0.
-    var p2 = Y00;
-    var p1 = sqrt(3.0) * z * Y00;
-    ybuf[2] = p1;
-    for (var l = 2u; l < bands; l++) {
-        let lf = f32(l);
-        let l1 = lf - 1.0;
-        let a = sqrt((4.0 * lf * lf - 1.0) / (lf * lf));
-        let b = sqrt((l1 * l1) / (4.0 * l1 * l1 - 1.0));
-        let p = a * (z * p1 - b * r2 * p2);
-        ybuf[l * l + l] = p;
-        p2 = p1;
-        p1 = p;
-    }
-    // m ≥ 1: √2·Π_l^m times C_m and S_m.
-    var pmm = Y00;
+    let r = sqrt(dot(d, d));
+    let x = d.x / r;
+    let y = d.y / r;
+    let u = (d.x * d.x + d.y * d.y) / (r * (r + abs(d.z)));
+    let t = 1.0 - u;
+    let below = d.z < 0.0;
     var c = 1.0;
     var s = 0.0;
-    for (var m = 1u; m < bands; m++) {
+    var fmm = Y00;
+    for (var m = 0u; m < bands; m++) {
         let mf = f32(m);
-        pmm = pmm * -sqrt((2.0 * mf + 1.0) / (2.0 * mf));
-        let cn = x * c - y * s;
-        let sn = x * s + y * c;
-        c = cn;
-        s = sn;
-        var q2 = sqrt(2.0) * pmm;
-        var at = m * m + m;
-        ybuf[at + m] = q2 * c;
-        ybuf[at - m] = q2 * s;
-        if (m + 1u == bands) {
-            break;
+        var scale = 1.0;
+        if (m > 0u) {
+            fmm = fmm * sqrt((2.0 * mf + 1.0) / (2.0 * mf));
+            let cn = x * c - y * s;
+            let sn = x * s + y * c;
+            c = cn;
+            s = sn;
+            scale = select(sqrt(2.0), -sqrt(2.0), (m & 1u) == 1u);
         }
-        var q1 = sqrt(2.0 * mf + 3.0) * z * q2;
-        at = at + 2u * m + 2u;
-        ybuf[at + m] = q1 * c;
-        ybuf[at - m] = q1 * s;
-        for (var l = m + 2u; l < bands; l++) {
+        var g = 1.0;
+        var e = 0.0;
+        var f = fmm;
+        for (var l = m; l < bands; l++) {
             let lf = f32(l);
-            let l1 = lf - 1.0;
-            let a = sqrt((4.0 * lf * lf - 1.0) / (lf * lf - mf * mf));
-            let b = sqrt((l1 * l1 - mf * mf) / (4.0 * l1 * l1 - 1.0));
-            let q = a * (z * q1 - b * r2 * q2);
-            let at2 = l * l + l;
-            ybuf[at2 + m] = q * c;
-            ybuf[at2 - m] = q * s;
-            q2 = q1;
-            q1 = q;
+            if (l > m) {
+                f = f * sqrt(((2.0 * lf + 1.0) * (lf + mf)) / ((2.0 * lf - 1.0) * (lf - mf)));
+                if (l == m + 1u) {
+                    e = -u;
+                    g = t;
+                } else {
+                    e = ((lf - mf - 1.0) * e - (2.0 * lf - 1.0) * u * g) / (lf + mf);
+                    g = g + e;
+                }
+            }
+            var q = scale * f * g;
+            if (below && ((l + m) & 1u) == 1u) {
+                q = -q;
+            }
+            let at = l * l + l;
+            if (m == 0u) {
+                ybuf[at] = q;
+            } else {
+                ybuf[at + m] = q * c;
+                ybuf[at - m] = q * s;
+            }
         }
     }
 }
@@ -88,17 +86,20 @@ fn sh_basis(d_in: vec3<f32>, bands: u32) {
 // The basis in `ybuf` at a cap's axis times each band's factor (mirrors
 // `sh::cap::band_scales`): k_l = √(4π/(2l+1))·L̃_l = 2π·sin²a·P_l′(cos a)/(l(l+1)),
 // k_0 = 4π·sin²(a/2), P_l′ by the derivative recurrence P′_{l+1} = P′_{l−1} + (2l+1)·P_l (a
-// sum of positive terms near cos a = 1: no cancellation for small caps), sin a and cos a from
-// a/2 as `sh::cap::cap_trig`. `ybuf` then holds ∫_cap Y_l^m dω of the cap of half-angle `a`.
+// sum of positive terms near cos a = 1: no cancellation for small caps), sin a from a/2 as
+// `sh::cap::cap_trig`. P_l itself by its recurrence on the differences d_l = P_l − P_{l−1}
+// with u = 1 − cos a = 2·sin²(a/2): (l+1)·d_{l+1} = l·d_l − (2l+1)·u·P_l (the Legendre
+// recurrence minus (l+1)·P_l), whose errors add where the plain one's grow like l² near
+// cos a = 1 (see `sh_basis`). `ybuf` then holds ∫_cap Y_l^m dω of the cap of half-angle `a`.
 fn sh_cap_scale(a: f32, bands: u32) {
     let sh = sin(0.5 * a);
     let ch = cos(0.5 * a);
     let s = 2.0 * sh * ch;
     let s2 = s * s;
-    let x = 1.0 - 2.0 * sh * sh;
+    let u = 2.0 * sh * sh;
     let pi = 3.14159265358979;
-    var p_prev = 1.0;
-    var p = x;
+    var p = 1.0 - u;
+    var d = -u;
     var dp_prev = 0.0;
     var dp = 1.0;
     for (var l = 0u; l < bands; l++) {
@@ -106,10 +107,10 @@ fn sh_cap_scale(a: f32, bands: u32) {
         if (l > 0u) {
             let lf = f32(l);
             k = 2.0 * pi * s2 * dp / (lf * (lf + 1.0));
-            let p_next = ((2.0 * lf + 1.0) * x * p - lf * p_prev) / (lf + 1.0);
+            let d_next = (lf * d - (2.0 * lf + 1.0) * u * p) / (lf + 1.0);
             let dp_next = dp_prev + (2.0 * lf + 1.0) * p;
-            p_prev = p;
-            p = p_next;
+            p = p + d_next;
+            d = d_next;
             dp_prev = dp;
             dp = dp_next;
         }

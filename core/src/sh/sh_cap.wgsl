@@ -2,7 +2,7 @@
 // `sh::cap::coefficients_into`, in f32): the basis at the axis (`sh_basis`) times each
 // band's factor (`sh_cap_scale`, both in `sh_basis.wgsl`). Input columns [x, y, z, a];
 // output column k = l² + l + m of `bands²`; the table (binding 3) is one f32, the band count
-// (1..=16). A half-angle outside [0, π] or NaN gives NaN in every output (the scalar
+// (1..=32). A half-angle outside [0, π] or NaN gives NaN in every output (the scalar
 // kernel's error).
 
 @group(0) @binding(3) var<storage, read> table: array<f32>;

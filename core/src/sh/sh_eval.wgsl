@@ -1,6 +1,6 @@
 // steradian: all bands² real SH at a direction (mirrors `sh::eval_into`, in f32, through
 // `sh_basis` of `sh_basis.wgsl`). Input columns [x, y, z]; output column k = l² + l + m of
-// `bands²`; the table (binding 3) is one f32, the band count (1..=16).
+// `bands²`; the table (binding 3) is one f32, the band count (1..=32).
 
 @group(0) @binding(3) var<storage, read> table: array<f32>;
 

@@ -3,7 +3,7 @@
 // normal (`sh_basis`), each band's dot product with the radiance coefficients, times the
 // band's clamped-cosine factor A_l, which the table carries. Input columns [x, y, z];
 // output one column; the table (binding 3) is [bands, A_0 … A_{bands−1}, L_0 … L_{bands²−1}]
-// (bands ≤ 16; A_l from `sh::irradiance::clamped_cosine`, rounded to f32).
+// (bands ≤ 32; A_l from `sh::irradiance::clamped_cosine`, rounded to f32).
 
 @group(0) @binding(3) var<storage, read> table: array<f32>;
 

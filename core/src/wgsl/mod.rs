@@ -203,28 +203,33 @@ pub const CP_QUERY: &str = concat!(
 /// `2.1e-7` from level 2 (harness test `tests/cp_gpu.rs`, which prints them).
 pub const CP_QUERY_TOL: f32 = 1.0e-5;
 
-/// All `bands²` real SH at a direction (`sh::eval_into`) in `f32`, for `bands ≤ 16`
+/// All `bands²` real SH at a direction (`sh::eval_into`) in `f32`, for `bands ≤ 32`
 /// ([`SH_EVAL_MAX_BANDS`]). Input columns `[x, y, z]`, output columns `l² + l + m`. Binding 3
 /// is one `f32`: the band count. Not in [`ALL`]: run it with the harness's custom kernels.
-/// WGSL has no `f64`, so unlike the scalar kernel the recurrence runs in `f32` (its rounding
-/// grows like `l²`: `1e-5` is reached near band 17), and its coefficients come from `sqrt`
-/// of the same rationals on the GPU. Tolerance: [`SH_EVAL_TOL`].
+/// WGSL has no `f64`, and the scalar kernel's recurrence in `f32` loses accuracy like `l²`
+/// near the poles (a double characteristic root at `|cos θ| = 1`: `1e-5` near band 17,
+/// `4.8e-5` at band 29), so the GPU runs the same Legendre recurrence per order on the
+/// ratios `P_l^m(t)/P_l^m(1)` and their differences, with `1 − |cos θ|` formed without
+/// cancellation (derived in `sh_basis.wgsl`): its errors add instead. Its coefficients come
+/// from `sqrt` of the same rationals on the GPU. Tolerance: [`SH_EVAL_TOL`].
 pub const SH_EVAL: &str = concat!(
     include_str!("batch.wgsl"),
     include_str!("../sh/sh_basis.wgsl"),
     include_str!("../sh/sh_eval.wgsl")
 );
-/// Largest band count of [`SH_EVAL`].
-pub const SH_EVAL_MAX_BANDS: usize = 16;
+/// Largest band count of [`SH_EVAL`], [`SH_CAP`] and [`SH_IRRADIANCE`]; more bands are
+/// clamped to it ([`SH_HVL`] clamps at 16).
+pub const SH_EVAL_MAX_BANDS: usize = 32;
 /// Absolute difference allowed between [`SH_EVAL`] and `sh::eval_into` per value, for up
-/// to [`SH_EVAL_MAX_BANDS`] bands (the values are at most `√((2l+1)/(2π))` ≈ 2.2 in size).
-/// Lavapipe: `1.7e-6` at 9 bands, `7.7e-6` at 16 (harness test `tests/sh_gpu.rs`, which
-/// prints them).
+/// to [`SH_EVAL_MAX_BANDS`] bands (the values are at most `√((2l+1)/(2π))` ≈ 3.2 in size).
+/// Lavapipe: `8.0e-7` at 9 bands, `1.4e-6` at 16, `3.0e-6` at 30 (harness test
+/// `tests/sh_gpu.rs`, which prints them).
 pub const SH_EVAL_TOL: f32 = 1.0e-5;
 
 /// The SH coefficients of spherical caps (`sh::cap::coefficients_into`) in `f32`, for
-/// `bands ≤ 16`: the basis of [`SH_EVAL`] at the axis times each band's factor
-/// `2π·sin²a·P_l′(cos a)/(l(l+1))` (the scalar kernel's `band_scales`, in `f32`). Input
+/// `bands ≤ 32`: the basis of [`SH_EVAL`] at the axis times each band's factor
+/// `2π·sin²a·P_l′(cos a)/(l(l+1))` (the scalar kernel's `band_scales`, in `f32`, `P_l` by
+/// its recurrence on differences so that small caps keep their accuracy). Input
 /// columns `[x, y, z, a]`, output columns `l² + l + m`; binding 3 is one `f32`, the band
 /// count. A half-angle outside `[0, π]` or NaN gives NaN (the scalar kernel's error). Not in
 /// [`ALL`]. Tolerance: [`SH_CAP_TOL`].
@@ -236,8 +241,8 @@ pub const SH_CAP: &str = concat!(
 /// Absolute difference allowed between [`SH_CAP`] and `sh::cap::coefficients_into` per
 /// coefficient, in units of the cap's solid angle `4π·sin²(a/2)` (every coefficient of band
 /// `l` is at most `√((2l+1)/4π)` of it), for half-angles from `1e-4` to `π`. Lavapipe:
-/// `2.0e-6` at 9 bands, `6.0e-6` at 16, the basis's error (harness test `tests/sh_gpu.rs`,
-/// which prints them).
+/// `8.4e-7` at 9 bands, `1.3e-6` at 16, `3.1e-6` at 30, the basis's error (harness test
+/// `tests/sh_gpu.rs`, which prints them).
 pub const SH_CAP_TOL: f32 = 1.0e-5;
 
 /// The built SH rotation operator (`sh::rotate::apply_operator`, the many-vectors path of
@@ -322,7 +327,7 @@ pub const SH_HVL_EXACT: &str = concat!(
 pub const SH_HVL_TOL: f32 = 2.0e-5;
 
 /// The irradiance of one radiance vector at many normals (`sh::irradiance::irradiance`) in
-/// `f32`, for `bands ≤ 16`: the basis of [`SH_EVAL`] at the normal, dotted band by band
+/// `f32`, for `bands ≤ 32`: the basis of [`SH_EVAL`] at the normal, dotted band by band
 /// with the radiance and weighted by the clamped-cosine factors. Input columns `[x, y, z]`,
 /// output one column; binding 3 is `[bands, A_0 … A_{bands−1}, L_0 … L_{bands²−1}]` (the
 /// factors of `sh::irradiance::clamped_cosine` rounded to `f32`, then the radiance). Not in
@@ -334,7 +339,7 @@ pub const SH_IRRADIANCE: &str = concat!(
 );
 /// Absolute difference allowed between [`SH_IRRADIANCE`] and `sh::irradiance::irradiance`,
 /// per unit of `Σ_l |A_l|·Σ_m |L_l^m|` (the basis's own tolerance [`SH_EVAL_TOL`] carried
-/// through the sum). Lavapipe: below `8e-8` through 16 bands (harness test
+/// through the sum). Lavapipe: below `1e-7` through 32 bands (harness test
 /// `tests/sh_gpu.rs`, which prints them).
 pub const SH_IRRADIANCE_TOL: f32 = 1.0e-5;
 
