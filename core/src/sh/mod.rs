@@ -35,14 +35,29 @@
 //!
 //! The coefficients are computed in `f64` at compile time ([`A`], [`AB`] `= a·b`, [`DIAG`],
 //! [`SUB`]: no table file, no square root at run time) and kept in `f64`; a step is
-//! `Π_l^m = (a_l^m·z)·Π_{l−1}^m − (a_l^m·b_l^m)·Π_{l−2}^m`, one multiply and one subtract on
-//! the dependency chain. It runs on the direction normalised in `f64`, where
-//! `x² + y² + z² = 1` to `3e-16`: the `1 − z²` that the textbook form eliminates through
+//! `Π_l^m = (a_l^m·z)·Π_{l−1}^m − (a_l^m·b_l^m·r²)·Π_{l−2}^m`, one multiply and one subtract
+//! on the dependency chain (see "Two forms" for `r²`). The `f64` direction is consistent
+//! (`r² = x² + y² + z²` to `3e-16`): the `1 − z²` that the textbook form eliminates through
 //! that identity costs nothing (in `f32` the same inconsistency, a few `1e-8`, is amplified
 //! by the Legendre polynomials' large coefficients to `5e-5` at 30 bands near the poles,
 //! one reason the recurrence is not run in `f32`). Cost per direction: about seven
-//! multiplications per coefficient, no division or square root after the normalisation of
-//! the direction.
+//! multiplications per coefficient, one square root and one division.
+//!
+//! ## Two forms: homogeneous (few bands) and normalised
+//!
+//! For the unnormalised point `(x, y, z)`, `r² = x² + y² + z²`, let `Q_l^m = r^{l−m}·Π_l^m(z/r)`.
+//! Multiplying the recurrence by `r^{l−m}` gives `Q_m^m = Π_m^m`,
+//! `Q_{m+1}^m = √(2m+3)·z·Q_m^m` and `Q_l^m = (a·z)·Q_{l−1}^m − (a·b·r²)·Q_{l−2}^m`; and
+//! `r^m·C_m(x/r, y/r) = C_m(x, y)`. So the recurrence on the raw point gives `r^l·Y_l^m`,
+//! and each value times `r^−l` is `Y_l^m` (on the unit sphere, `r = 1`, it is the plain
+//! recurrence). So the recurrence need not wait for `1/r`: the square root and the division run
+//! beside it, and meet it in one product per value. For a few bands the evaluation's time
+//! is that latency, and the homogeneous form ([`point`], through
+//! [`HOMOGENEOUS_MAX_BANDS`] = 6) is faster; for more bands it is bound by its operation
+//! count, and the normalised form ([`Point::normalized`]: the same code on `(x, y, z)/r`
+//! with `r² = r^−l = 1`, whose products by 1 are exact and fold away) saves that product.
+//! [`form`] picks one per band count; both are within the same bound of the reference
+//! (tested at every length an `f32` vector can have).
 //!
 //! **Precision: `f64` inside, `f32` in and out.** The crate's kernels compute in `f32`; this
 //! one normalises the `f32` direction in `f64`, runs its recurrence in `f64` with `f64`
@@ -74,8 +89,8 @@
 //!
 //! ## Bad input
 //!
-//! The direction need not be unit: it is normalised in `f64`, where no `f32` vector
-//! overflows or underflows. The zero vector evaluates at the pole `+z`; a
+//! The direction need not be unit: `r²` of no `f32` vector overflows or underflows in
+//! `f64`, nor do `r^l`, `r^−l` through 6 bands. The zero vector evaluates at the pole `+z`; a
 //! non-finite direction gives NaN in every value. A band count above [`MAX_BANDS`] or an
 //! output slice shorter than `n²` is an error, not a panic.
 //!
@@ -277,6 +292,82 @@ pub fn unit_direction(d: Vec3) -> DVec3 {
     DVec3::new(x * inv, y * inv, z * inv)
 }
 
+/// The point the recurrence of [`eval_into`] runs on (module docs, "Two forms"): `p` is `d`
+/// in `f64`, `r2 = |p|²` summed left to right, `inv = 1/√r2` (one correctly rounded square
+/// root, one division). The zero vector → `+z` (`r2 = inv = 1`); a non-finite component →
+/// NaN everywhere.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Point {
+    /// The direction, unnormalised.
+    pub p: DVec3,
+    /// `|p|²`.
+    pub r2: f64,
+    /// `1/√r2`.
+    pub inv: f64,
+}
+
+/// [`Point`] of `d`: the operations its SIMD twin (`steradian_simd::sh`) repeats on each
+/// lane.
+#[inline]
+pub fn point(d: Vec3) -> Point {
+    let (x, y, z) = (f64::from(d.x), f64::from(d.y), f64::from(d.z));
+    let r2 = x * x + y * y + z * z;
+    if r2 == 0.0 {
+        return Point {
+            p: DVec3::Z,
+            r2: 1.0,
+            inv: 1.0,
+        };
+    }
+    if !r2.is_finite() {
+        return Point {
+            p: DVec3::splat(f64::NAN),
+            r2: f64::NAN,
+            inv: f64::NAN,
+        };
+    }
+    Point {
+        p: DVec3::new(x, y, z),
+        r2,
+        inv: 1.0 / math::sqrt64(r2),
+    }
+}
+
+impl Point {
+    /// The same direction normalised, `p·inv` with `r2 = inv = 1`: the homogeneous
+    /// recurrence on it is the normalised one (`1·Π`, `Π·1` are exact), bit for bit.
+    #[inline(always)]
+    pub fn normalized(self) -> Point {
+        Point {
+            p: self.p * self.inv,
+            r2: 1.0,
+            inv: 1.0,
+        }
+    }
+}
+
+/// The most bands evaluated in the homogeneous form (module docs, "Two forms"): where the
+/// evaluation is short its time is the latency of the normalisation followed by the
+/// recurrence's chain, and the homogeneous form runs the two side by side; beyond, the
+/// evaluation is bound by its operation count and the normalised form, one multiply per
+/// value fewer, is faster (`steradian report --section sh`). At most 7, so that `r^l` and
+/// `r^−l`, `l ≤ 6`, of any non-zero finite `f32` vector (`|d|` from `1.4e-45` to `5.9e38`)
+/// stay normal `f64`s: `1.4e-45⁶ ≈ 7e-271`, `5.9e38⁶ ≈ 4e232`.
+pub const HOMOGENEOUS_MAX_BANDS: usize = 6;
+const _: () = assert!(HOMOGENEOUS_MAX_BANDS <= 7);
+
+/// The point `pt` (of [`point`]) in the form [`eval_into`] uses for `bands` bands:
+/// homogeneous through [`HOMOGENEOUS_MAX_BANDS`], [`Point::normalized`] beyond. Called with a
+/// constant band count, the choice and the normalised form's products by 1 fold away.
+#[inline(always)]
+pub fn form(pt: Point, bands: usize) -> Point {
+    if bands <= HOMOGENEOUS_MAX_BANDS {
+        pt
+    } else {
+        pt.normalized()
+    }
+}
+
 /// Orders `m` whose recurrences in `l` run together in one pass of [`eval_into`] (and of
 /// its SIMD twin): four independent chains hide the latency of each one's multiply and
 /// subtract. Part of the kernel's definition only through speed: every value is computed by
@@ -293,21 +384,21 @@ pub const fn group(left: usize) -> usize {
     if left <= MAX_GROUP { left } else { CHAINS }
 }
 
-/// One step of the recurrence, `Π_l^m = (a_l^m·z)·Π_{l−1}^m − (a_l^m·b_l^m)·Π_{l−2}^m` at
-/// `k = tri(l, m)`: the coefficient products are off the chain, so each step adds one
-/// multiply and one subtract of latency.
+/// One step of the homogeneous recurrence,
+/// `Π_l^m = (a_l^m·z)·Π_{l−1}^m − (a_l^m·b_l^m·r²)·Π_{l−2}^m` at `k = tri(l, m)`: the
+/// coefficient products are off the chain, so each step adds one multiply and one subtract
+/// of latency.
 #[inline(always)]
-fn step(k: usize, z: f64, q1: f64, q2: f64) -> f64 {
-    A[k] * z * q1 - AB[k] * q2
+fn step(k: usize, z: f64, r2: f64, q1: f64, q2: f64) -> f64 {
+    A[k] * z * q1 - AB[k] * r2 * q2
 }
 
-/// The recurrence over `bands` bands at the unit direction `d` into `out[..bands²]`
-/// (`bands ≤ MAX_BANDS`, `out.len() ≥ bands²`: checked by the callers). Shared by the
-/// fixed-size and the dynamic entry points, so both give the same bits.
+/// The recurrence over `bands` bands at the point `pt` (of either form, module docs) into
+/// `out[..bands²]` (`bands ≤ MAX_BANDS`, `out.len() ≥ bands²`: checked by the callers).
+/// Shared by the fixed-size and the dynamic entry points, so both give the same bits.
 ///
 /// The recurrence runs in `f64`, one rounding to `f32` per output (module docs,
-/// "Accuracy"), on the `f64` unit vector, where `x² + y² + z² = 1` to `3e-16`; the
-/// homogeneous `r²` of an unnormalised point is therefore left out.
+/// "Accuracy"); each value is `q·r^−l` times `S_m`, then `C_m`.
 ///
 /// **[`CHAINS`] orders at a time.** The recurrence in `l` is a chain of dependent
 /// operations per order `m`, so the orders `m0 .. m0 + 3` run in the same loop over `l`,
@@ -319,12 +410,15 @@ fn step(k: usize, z: f64, q1: f64, q2: f64) -> f64 {
 /// value itself). The SIMD twin does the same operations in the same order and is tested
 /// bit for bit.
 #[inline(always)]
-fn fill(d: DVec3, bands: usize, out: &mut [f32]) {
+fn fill(pt: Point, bands: usize, out: &mut [f32]) {
     let out = &mut out[..bands * bands];
     if bands == 0 {
         return;
     }
-    let (x, y, z) = (d.x, d.y, d.z);
+    let (x, y, z, r2, inv) = (pt.p.x, pt.p.y, pt.p.z, pt.r2, pt.inv);
+    // r^−l by `il_l = il_{l−1}·inv` from `il_0 = 1` (the order the generated code
+    // repeats): `il_m0` at the pass's first row, then the head's rows, then running.
+    let mut il_m0 = 1.0f64;
     let (mut pmm, mut c, mut s) = (Y00_F64, 1.0f64, 0.0f64);
     let mut m0 = 0;
     while m0 < bands {
@@ -348,6 +442,10 @@ fn fill(d: DVec3, bands: usize, out: &mut [f32]) {
         // The first rows, one chain after the other: chain j starts at row m0 + j and
         // steps from row m0 + j + 2.
         let head = (m0 + g + 1).min(bands);
+        let mut ilh = [il_m0; MAX_GROUP + 1];
+        for r in 1..head - m0 {
+            ilh[r] = ilh[r - 1] * inv;
+        }
         for j in 0..g {
             let m = m0 + j;
             let (mut p1, mut p2) = (q1[j], 0.0);
@@ -357,35 +455,43 @@ fn fill(d: DVec3, bands: usize, out: &mut [f32]) {
                 } else if l == m + 1 {
                     SUB[m] * z * p1
                 } else {
-                    step(tri(l, m), z, p1, p2)
+                    step(tri(l, m), z, r2, p1, p2)
                 };
                 if l > m {
                     (p2, p1) = (p1, q);
                 }
+                let v = q * ilh[l - m0];
                 let at = l * l + l;
-                out[at - m] = (q * ss[j]) as f32;
-                out[at + m] = (q * cc[j]) as f32;
+                out[at - m] = (v * ss[j]) as f32;
+                out[at + m] = (v * cc[j]) as f32;
             }
             (q1[j], q2[j]) = (p1, p2);
         }
         // The rest: every chain steps (only groups of `CHAINS` reach here: the last group,
         // of any other size, takes every remaining order, so its head ends at `bands`).
+        let mut il = ilh[head - 1 - m0];
         for l in head..bands {
+            il *= inv;
             let at = l * l + l;
             let k = tri(l, m0);
             let (a, ab) = (&A[k..k + CHAINS], &AB[k..k + CHAINS]);
             let (mut sin, mut cos) = ([0.0f32; CHAINS], [0.0f32; CHAINS]);
             for j in 0..CHAINS {
-                let q = a[j] * z * q1[j] - ab[j] * q2[j];
+                let q = a[j] * z * q1[j] - ab[j] * r2 * q2[j];
                 (q2[j], q1[j]) = (q1[j], q);
-                sin[CHAINS - 1 - j] = (q * ss[j]) as f32;
-                cos[j] = (q * cc[j]) as f32;
+                let v = q * il;
+                sin[CHAINS - 1 - j] = (v * ss[j]) as f32;
+                cos[j] = (v * cc[j]) as f32;
             }
             // Orders m0 + 3 … m0 below the centre, m0 … m0 + 3 above (they meet at the
             // centre only for m0 = 0, where the cosine part, written last, is the value).
             let lo = at - m0 - (CHAINS - 1);
             out[lo..lo + CHAINS].copy_from_slice(&sin);
             out[at + m0..at + m0 + CHAINS].copy_from_slice(&cos);
+        }
+        // The next pass's first row, m0 + g, is in this head when there is one.
+        if m0 + g < bands {
+            il_m0 = ilh[g];
         }
         m0 += g;
     }
@@ -398,8 +504,7 @@ fn fill(d: DVec3, bands: usize, out: &mut [f32]) {
 /// Errors: `bands > MAX_BANDS`, or `out` shorter than `bands²`.
 pub fn eval_into(dir: Vec3, bands: usize, out: &mut [f32]) -> Result<(), Error> {
     check_shape(bands, out.len())?;
-    let d = unit_direction(dir);
-    fill_any(d, bands, out);
+    fill_any(point(dir), bands, out);
     Ok(())
 }
 
@@ -407,24 +512,25 @@ pub fn eval_into(dir: Vec3, bands: usize, out: &mut [f32]) -> Result<(), Error> 
 /// this recurrence: each value by the same operations, bit-identical, tested) for the band
 /// counts renderers use most, 2–10.
 #[inline(always)]
-fn fill_any(d: DVec3, bands: usize, out: &mut [f32]) {
+fn fill_any(pt: Point, bands: usize, out: &mut [f32]) {
     match bands {
-        2 => fixed::fill_2(d, out),
-        3 => fixed::fill_3(d, out),
-        4 => fixed::fill_4(d, out),
-        5 => fixed::fill_5(d, out),
-        6 => fixed::fill_6(d, out),
-        7 => fixed::fill_7(d, out),
-        8 => fixed::fill_8(d, out),
-        9 => fixed::fill_9(d, out),
-        10 => fixed::fill_10(d, out),
-        _ => fill(d, bands, out),
+        2 => fixed::fill_2(form(pt, 2), out),
+        3 => fixed::fill_3(form(pt, 3), out),
+        4 => fixed::fill_4(form(pt, 4), out),
+        5 => fixed::fill_5(form(pt, 5), out),
+        6 => fixed::fill_6(form(pt, 6), out),
+        7 => fixed::fill_7(form(pt, 7), out),
+        8 => fixed::fill_8(form(pt, 8), out),
+        9 => fixed::fill_9(form(pt, 9), out),
+        10 => fixed::fill_10(form(pt, 10), out),
+        _ if bands > HOMOGENEOUS_MAX_BANDS => fill(pt.normalized(), bands, out),
+        _ => fill(pt, bands, out),
     }
 }
 
 /// The zonal functions `Y_l^0`, `l < bands`, at `dir` into `out[..bands]`: the `m = 0`
 /// chain of [`eval_into`]'s recurrence alone (`Π_0^0`, `Π_1^0 = √3·z·Π_0^0`, then
-/// [`step`]), the same operations on the same `f64` unit vector, so each value is
+/// [`step`], each times `r^−l`), the same operations on the same point, so each value is
 /// bit-identical to `eval_into`'s at index `l² + l` (tested). What a receiver whose
 /// coefficients are zonal around its normal needs (`sh::hvl::contribution_zonal`): `bands`
 /// values instead of `bands²`.
@@ -443,17 +549,20 @@ pub fn eval_zonal_into(dir: Vec3, bands: usize, out: &mut [f32]) -> Result<(), E
     if bands == 0 {
         return Ok(());
     }
-    let z = unit_direction(dir).z;
+    let pt = form(point(dir), bands);
+    let (z, r2) = (pt.p.z, pt.r2);
     out[0] = (Y00_F64 + 0.0 * z) as f32;
     let (mut q1, mut q2) = (Y00_F64, 0.0f64);
+    let mut il = 1.0f64;
     for (l, o) in out[..bands].iter_mut().enumerate().skip(1) {
         let q = if l == 1 {
             SUB[0] * z * q1
         } else {
-            step(tri(l, 0), z, q1, q2)
+            step(tri(l, 0), z, r2, q1, q2)
         };
         (q2, q1) = (q1, q);
-        *o = q as f32;
+        il *= pt.inv;
+        *o = (q * il) as f32;
     }
     Ok(())
 }
@@ -515,7 +624,7 @@ pub fn eval_fixed<const C: usize>(dir: Vec3) -> [f32; C] {
         )
     };
     let mut out = [0.0f32; C];
-    fill_any(unit_direction(dir), isqrt(C), &mut out);
+    fill_any(point(dir), isqrt(C), &mut out);
     out
 }
 
@@ -629,6 +738,48 @@ mod tests {
         }
     }
 
+    /// The homogeneous form (1–6 bands) and the first normalised count (7) within the
+    /// per-band bound of the reference, at unit directions and at the extreme lengths of
+    /// `f32` vectors (where `r^l`, `r^−l` are largest and smallest), the zero vector at `+z`.
+    #[test]
+    fn both_forms_within_the_bound_at_any_length() {
+        let mut worst = 0.0f64;
+        for n in 1..=HOMOGENEOUS_MAX_BANDS + 1 {
+            for d in directions().into_iter().step_by(4) {
+                for scale in [1.0f32, 1e-40, 1e-20, 3e18, 1e38] {
+                    let v = d * scale;
+                    let got = eval(v, n);
+                    let want = reference::eval([v.x as f64, v.y as f64, v.z as f64], n);
+                    for l in 0..n {
+                        for m in -(l as isize)..=l as isize {
+                            let i = index(l, m);
+                            let err = (got[i] as f64 - want[i]).abs();
+                            worst = worst.max(err);
+                            assert!(
+                                err <= eval_abs_error(l) as f64,
+                                "{v:?} n {n} ({l}, {m}): {} vs {}",
+                                got[i],
+                                want[i]
+                            );
+                        }
+                    }
+                }
+            }
+            assert_eq!(eval(Vec3::ZERO, n), eval(Vec3::Z, n));
+            assert!(
+                eval(Vec3::new(f32::NAN, 0.0, 1.0), n)
+                    .iter()
+                    .all(|v| v.is_nan())
+            );
+            assert!(
+                eval(Vec3::new(f32::INFINITY, 0.0, 1.0), n)
+                    .iter()
+                    .all(|v| v.is_nan())
+            );
+        }
+        std::println!("both forms, 1-7 bands, any length: worst {worst:e}");
+    }
+
     /// The stated per-band bound against the independent f64 reference, and 1e-5 through
     /// 30 bands.
     #[test]
@@ -733,9 +884,9 @@ mod tests {
         let dirs = hard_directions();
         for n in 2..=10usize {
             for &d in &dirs {
-                let u = unit_direction(d);
+                let u = point(d);
                 let (mut a, mut b) = (vec![0.0f32; n * n], vec![0.0f32; n * n]);
-                fill(u, n, &mut a);
+                fill(form(u, n), n, &mut a);
                 fill_any(u, n, &mut b);
                 for (k, (x, y)) in a.iter().zip(&b).enumerate() {
                     assert_eq!(x.to_bits(), y.to_bits(), "{d:?} n {n} index {k}");
@@ -743,7 +894,7 @@ mod tests {
             }
             // A short output is left alone, not a panic.
             let mut short = vec![5.0f32; n * n - 1];
-            fill_any(DVec3::Z, n, &mut short);
+            fill_any(point(Vec3::Z), n, &mut short);
             assert!(short.iter().all(|&v| v == 5.0));
         }
     }

@@ -1,10 +1,10 @@
 //! Real spherical harmonics, four or eight directions at a time (mirrors
 //! `steradian_core::sh`).
 //!
-//! [`eval_x4`] ([`eval_x8`]) normalises the directions on `wide::f64x4` (`f64x8`) lanes with
-//! the operations of
-//! `steradian_core::sh::unit_direction` (one correctly rounded square root, division and
-//! three products per lane) and runs the scalar kernel's `f64` recurrence on the lanes with
+//! [`eval_x4`] ([`eval_x8`]) forms the point of `steradian_core::sh::point` on `wide::f64x4`
+//! (`f64x8`) lanes (one correctly rounded square root and division per lane), in the form
+//! `steradian_core::sh::form` picks for the band count, and runs the scalar kernel's `f64`
+//! recurrence on the lanes with
 //! the same operations in the same order, the same orders `m` grouped by
 //! `steradian_core::sh::CHAINS` (the per-order constants `Π_m^m` and `√2·Π_m^m` do not
 //! depend on the direction and are computed once per batch), so every lane is
@@ -22,7 +22,10 @@ pub mod irradiance;
 pub mod rotate;
 
 use core::ops::{Add, Mul, Sub};
-use steradian_core::sh::{A, AB, CHAINS, DIAG, MAX_GROUP, SUB, Y00_F64, check_shape, group, tri};
+use steradian_core::sh::{
+    A, AB, CHAINS, DIAG, HOMOGENEOUS_MAX_BANDS, MAX_BANDS, MAX_GROUP, SUB, Y00_F64, check_shape,
+    group, tri,
+};
 #[rustfmt::skip]
 mod fixed;
 
@@ -63,20 +66,18 @@ macro_rules! lanes_kernels {
             core::array::from_fn(|k| a[k] as f32)
         }
 
-        /// `steradian_core::sh::unit_direction` on the lanes: the same operations (`r²`
-        /// summed left to right, `1/√r²`, three products), `+z` where `r² = 0`, NaN where `r²`
-        /// is not finite.
+        /// `steradian_core::sh::point` on the lanes, `[x, y, z, r², 1/√r²]`: the same
+        /// operations (`r²` summed left to right, one square root and one division), `+z`
+        /// with `r² = 1/√r² = 1` where `r² = 0`, NaN where `r²` is not finite.
         #[inline(always)]
-        fn $unit(x: $t, y: $t, z: $t) -> [$t; 3] {
+        fn $unit(x: $t, y: $t, z: $t) -> [$t; 5] {
             let r2 = x * x + y * y + z * z;
-            let inv = $t::ONE / r2.sqrt();
             let zero = r2.simd_eq($t::ZERO);
             let finite = r2.simd_lt($t::splat(f64::INFINITY));
+            let inv = $t::ONE / r2.sqrt();
             let nan = $t::splat(f64::NAN);
-            let fix = |v: $t, at_zero: f64| {
-                finite.select(zero.select($t::splat(at_zero), v * inv), nan)
-            };
-            [fix(x, 0.0), fix(y, 0.0), fix(z, 1.0)]
+            let fix = |v: $t, at_zero: f64| finite.select(zero.select($t::splat(at_zero), v), nan);
+            [fix(x, 0.0), fix(y, 0.0), fix(z, 1.0), fix(r2, 1.0), fix(inv, 1.0)]
         }
     };
 }
@@ -88,25 +89,47 @@ lanes_kernels!(f64x8, 8, eval_x8, narrow8, unit_lanes8, "eight");
 /// `put(k, v)` receives coefficient `k` (the sine part of each `(l, m)` before its cosine
 /// part, coefficient 0 last, as the scalar kernel writes them).
 #[inline(always)]
-fn fill<F: F64Lanes>(u: [F; 3], bands: usize, put: &mut impl FnMut(usize, F)) {
+fn fill<F: F64Lanes>(u: [F; 5], bands: usize, put: &mut impl FnMut(usize, F)) {
     // The straight-line code generated from this recurrence for 2–10 bands (the same
     // operations per value, as the scalar kernel's).
     match bands {
-        0 => return,
-        2 => return fixed::fill_2(u, put),
-        3 => return fixed::fill_3(u, put),
-        4 => return fixed::fill_4(u, put),
-        5 => return fixed::fill_5(u, put),
-        6 => return fixed::fill_6(u, put),
-        7 => return fixed::fill_7(u, put),
-        8 => return fixed::fill_8(u, put),
-        9 => return fixed::fill_9(u, put),
-        10 => return fixed::fill_10(u, put),
-        _ => {}
+        0 => {}
+        2 => fixed::fill_2(form(u, 2), put),
+        3 => fixed::fill_3(form(u, 3), put),
+        4 => fixed::fill_4(form(u, 4), put),
+        5 => fixed::fill_5(form(u, 5), put),
+        6 => fixed::fill_6(form(u, 6), put),
+        7 => fixed::fill_7(form(u, 7), put),
+        8 => fixed::fill_8(form(u, 8), put),
+        9 => fixed::fill_9(form(u, 9), put),
+        10 => fixed::fill_10(form(u, 10), put),
+        _ if bands > HOMOGENEOUS_MAX_BANDS => fill_loop(form(u, MAX_BANDS), bands, put),
+        _ => fill_loop(u, bands, put),
     }
-    let [x, y, z] = u;
+}
+
+/// `steradian_core::sh::form` on the lanes: `[x·inv, y·inv, z·inv, 1, 1]` beyond
+/// `HOMOGENEOUS_MAX_BANDS` (`Point::normalized`), the homogeneous point otherwise.
+#[inline(always)]
+fn form<F: F64Lanes>(u: [F; 5], bands: usize) -> [F; 5] {
+    if bands <= HOMOGENEOUS_MAX_BANDS {
+        u
+    } else {
+        let [x, y, z, _, inv] = u;
+        [x * inv, y * inv, z * inv, F::splat(1.0), F::splat(1.0)]
+    }
+}
+
+/// The loop of [`fill`] (band counts without straight-line code), on the point `u` of the
+/// form [`form`] chose.
+#[inline(always)]
+fn fill_loop<F: F64Lanes>(u: [F; 5], bands: usize, put: &mut impl FnMut(usize, F)) {
+    let [x, y, z, r2, inv] = u;
     let sp = F::splat;
-    let step = |k: usize, q1: F, q2: F| sp(A[k]) * z * q1 - sp(AB[k]) * q2;
+    let step = |k: usize, q1: F, q2: F| sp(A[k]) * z * q1 - sp(AB[k]) * r2 * q2;
+    // r^−l as the scalar kernel's `il_l = il_{l−1}·inv`: at the pass's first row, the
+    // head's rows, then running.
+    let mut il_m0 = sp(1.0);
     let (mut pmm, mut c, mut s) = (Y00_F64, sp(1.0), sp(0.0));
     let mut m0 = 0;
     while m0 < bands {
@@ -127,6 +150,10 @@ fn fill<F: F64Lanes>(u: [F; 3], bands: usize, put: &mut impl FnMut(usize, F)) {
             });
         }
         let head = (m0 + g + 1).min(bands);
+        let mut ilh = [il_m0; MAX_GROUP + 1];
+        for r in 1..head - m0 {
+            ilh[r] = ilh[r - 1] * inv;
+        }
         for j in 0..g {
             let m = m0 + j;
             let (mut p1, mut p2) = (q1[j], sp(0.0));
@@ -141,21 +168,29 @@ fn fill<F: F64Lanes>(u: [F; 3], bands: usize, put: &mut impl FnMut(usize, F)) {
                 if l > m {
                     (p2, p1) = (p1, q);
                 }
+                let v = q * ilh[l - m0];
                 let at = l * l + l;
-                put(at - m, q * ss[j]);
-                put(at + m, q * cc[j]);
+                put(at - m, v * ss[j]);
+                put(at + m, v * cc[j]);
             }
             (q1[j], q2[j]) = (p1, p2);
         }
+        let mut il = ilh[head - 1 - m0];
         for l in head..bands {
+            il = il * inv;
             let at = l * l + l;
             let k = tri(l, m0);
             for j in 0..CHAINS {
                 let q = step(k + j, q1[j], q2[j]);
                 (q2[j], q1[j]) = (q1[j], q);
-                put(at - m0 - j, q * ss[j]);
-                put(at + m0 + j, q * cc[j]);
+                let v = q * il;
+                put(at - m0 - j, v * ss[j]);
+                put(at + m0 + j, v * cc[j]);
             }
+        }
+        // The next pass's first row, m0 + g, is in this head when there is one.
+        if m0 + g < bands {
+            il_m0 = ilh[g];
         }
         m0 += g;
     }
