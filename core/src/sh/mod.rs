@@ -398,7 +398,7 @@ fn step(k: usize, z: f64, r2: f64, q1: f64, q2: f64) -> f64 {
 /// Shared by the fixed-size and the dynamic entry points, so both give the same bits.
 ///
 /// The recurrence runs in `f64`, one rounding to `f32` per output (module docs,
-/// "Accuracy"); each value is `q·r^−l` times `S_m`, then `C_m`.
+/// "Accuracy"); each value is `q·S_m`, then `q·C_m`, times `r^−l` (the one product that waits for the normalisation).
 ///
 /// **[`CHAINS`] orders at a time.** The recurrence in `l` is a chain of dependent
 /// operations per order `m`, so the orders `m0 .. m0 + 3` run in the same loop over `l`,
@@ -409,8 +409,11 @@ fn step(k: usize, z: f64, r2: f64, q1: f64, q2: f64) -> f64 {
 /// `q·C_m` at `l² + l + m` (for `m = 0`, `C = 1` and `S = 0` make the second write the
 /// value itself). The SIMD twin does the same operations in the same order and is tested
 /// bit for bit.
+///
+/// `H` is the form: `false` skips the products by `r^−l`, all exactly 1 on a normalised
+/// point, which the compiler cannot see through the loop (same bits, fewer operations).
 #[inline(always)]
-fn fill(pt: Point, bands: usize, out: &mut [f32]) {
+fn fill<const H: bool>(pt: Point, bands: usize, out: &mut [f32]) {
     let out = &mut out[..bands * bands];
     if bands == 0 {
         return;
@@ -460,10 +463,10 @@ fn fill(pt: Point, bands: usize, out: &mut [f32]) {
                 if l > m {
                     (p2, p1) = (p1, q);
                 }
-                let v = q * ilh[l - m0];
+                let il = ilh[l - m0];
                 let at = l * l + l;
-                out[at - m] = (v * ss[j]) as f32;
-                out[at + m] = (v * cc[j]) as f32;
+                out[at - m] = scaled::<H>(q * ss[j], il) as f32;
+                out[at + m] = scaled::<H>(q * cc[j], il) as f32;
             }
             (q1[j], q2[j]) = (p1, p2);
         }
@@ -479,9 +482,8 @@ fn fill(pt: Point, bands: usize, out: &mut [f32]) {
             for j in 0..CHAINS {
                 let q = a[j] * z * q1[j] - ab[j] * r2 * q2[j];
                 (q2[j], q1[j]) = (q1[j], q);
-                let v = q * il;
-                sin[CHAINS - 1 - j] = (v * ss[j]) as f32;
-                cos[j] = (v * cc[j]) as f32;
+                sin[CHAINS - 1 - j] = scaled::<H>(q * ss[j], il) as f32;
+                cos[j] = scaled::<H>(q * cc[j], il) as f32;
             }
             // Orders m0 + 3 … m0 below the centre, m0 … m0 + 3 above (they meet at the
             // centre only for m0 = 0, where the cosine part, written last, is the value).
@@ -497,6 +499,20 @@ fn fill(pt: Point, bands: usize, out: &mut [f32]) {
     }
     // `+ 0·z`: NaN for a NaN direction (crate convention), exactly `Y00` otherwise.
     out[0] = (Y00_F64 + 0.0 * z) as f32;
+}
+
+/// [`fill`] in the homogeneous form for the counts without straight-line code below
+/// [`HOMOGENEOUS_MAX_BANDS`] (0 and 1 bands), out of line: a second inlined copy of the loop
+/// made the normalised one slower at 20 bands (`steradian report --section sh`).
+#[inline(never)]
+fn fill_short(pt: Point, bands: usize, out: &mut [f32]) {
+    fill::<true>(pt, bands, out);
+}
+
+/// `v·il` in the homogeneous form, `v` in the normalised one (where `il = 1`).
+#[inline(always)]
+fn scaled<const H: bool>(v: f64, il: f64) -> f64 {
+    if H { v * il } else { v }
 }
 
 /// All `bands²` real SH at `dir` (any non-zero length; module docs) into `out[..bands²]`.
@@ -523,8 +539,8 @@ fn fill_any(pt: Point, bands: usize, out: &mut [f32]) {
         8 => fixed::fill_8(form(pt, 8), out),
         9 => fixed::fill_9(form(pt, 9), out),
         10 => fixed::fill_10(form(pt, 10), out),
-        _ if bands > HOMOGENEOUS_MAX_BANDS => fill(pt.normalized(), bands, out),
-        _ => fill(pt, bands, out),
+        _ if bands > HOMOGENEOUS_MAX_BANDS => fill::<false>(pt.normalized(), bands, out),
+        _ => fill_short(pt, bands, out),
     }
 }
 
@@ -886,7 +902,9 @@ mod tests {
             for &d in &dirs {
                 let u = point(d);
                 let (mut a, mut b) = (vec![0.0f32; n * n], vec![0.0f32; n * n]);
-                fill(form(u, n), n, &mut a);
+                // The homogeneous loop on either form (on a normalised point its
+                // products by r^−l are by exact 1s).
+                fill::<true>(form(u, n), n, &mut a);
                 fill_any(u, n, &mut b);
                 for (k, (x, y)) in a.iter().zip(&b).enumerate() {
                     assert_eq!(x.to_bits(), y.to_bits(), "{d:?} n {n} index {k}");

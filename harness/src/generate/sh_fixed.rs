@@ -133,16 +133,16 @@ fn function(n: usize, lanes: bool, out: &mut String) {
             }
             // The value goes out as q·S_m, then q·C_m; for m = 0 (C = 1, S = 0) that is q
             // itself (q·1 = q exactly), and coefficient 0 is written once, last.
-            // Each value times r^−l first (`fill`'s `v = q·il[l]`).
+            // Each value q·S (q·C) times r^−l last (`fill`'s order: only that product waits
+            // for the normalisation).
             let at = l * l + l;
             if m == 0 {
                 if l > 0 {
                     put(out, at, format!("q{l}_0 * i{l}"));
                 }
             } else {
-                w(out, format!("let v{l}_{m} = q{l}_{m} * i{l};"));
-                put(out, at - m, format!("v{l}_{m} * s{m}"));
-                put(out, at + m, format!("v{l}_{m} * c{m}"));
+                put(out, at - m, format!("q{l}_{m} * s{m} * i{l}"));
+                put(out, at + m, format!("q{l}_{m} * c{m} * i{l}"));
             }
         }
     }

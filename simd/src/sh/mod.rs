@@ -103,9 +103,16 @@ fn fill<F: F64Lanes>(u: [F; 5], bands: usize, put: &mut impl FnMut(usize, F)) {
         8 => fixed::fill_8(form(u, 8), put),
         9 => fixed::fill_9(form(u, 9), put),
         10 => fixed::fill_10(form(u, 10), put),
-        _ if bands > HOMOGENEOUS_MAX_BANDS => fill_loop(form(u, MAX_BANDS), bands, put),
-        _ => fill_loop(u, bands, put),
+        _ if bands > HOMOGENEOUS_MAX_BANDS => fill_loop::<false, F>(form(u, MAX_BANDS), bands, put),
+        _ => fill_short(u, bands, put),
     }
+}
+
+/// The homogeneous loop for 0 and 1 bands, out of line (as the scalar kernel's
+/// `fill_short`: a second inlined copy of the loop slows the normalised one).
+#[inline(never)]
+fn fill_short<F: F64Lanes>(u: [F; 5], bands: usize, put: &mut impl FnMut(usize, F)) {
+    fill_loop::<true, F>(u, bands, put);
 }
 
 /// `steradian_core::sh::form` on the lanes: `[x·inv, y·inv, z·inv, 1, 1]` beyond
@@ -121,9 +128,11 @@ fn form<F: F64Lanes>(u: [F; 5], bands: usize) -> [F; 5] {
 }
 
 /// The loop of [`fill`] (band counts without straight-line code), on the point `u` of the
-/// form [`form`] chose.
+/// form [`form`] chose; `H = false` skips the products by `r^−l = 1` (the scalar loop's
+/// `H`).
 #[inline(always)]
-fn fill_loop<F: F64Lanes>(u: [F; 5], bands: usize, put: &mut impl FnMut(usize, F)) {
+fn fill_loop<const H: bool, F: F64Lanes>(u: [F; 5], bands: usize, put: &mut impl FnMut(usize, F)) {
+    let scaled = |v: F, il: F| if H { v * il } else { v };
     let [x, y, z, r2, inv] = u;
     let sp = F::splat;
     let step = |k: usize, q1: F, q2: F| sp(A[k]) * z * q1 - sp(AB[k]) * r2 * q2;
@@ -168,10 +177,10 @@ fn fill_loop<F: F64Lanes>(u: [F; 5], bands: usize, put: &mut impl FnMut(usize, F
                 if l > m {
                     (p2, p1) = (p1, q);
                 }
-                let v = q * ilh[l - m0];
+                let il = ilh[l - m0];
                 let at = l * l + l;
-                put(at - m, v * ss[j]);
-                put(at + m, v * cc[j]);
+                put(at - m, scaled(q * ss[j], il));
+                put(at + m, scaled(q * cc[j], il));
             }
             (q1[j], q2[j]) = (p1, p2);
         }
@@ -183,9 +192,8 @@ fn fill_loop<F: F64Lanes>(u: [F; 5], bands: usize, put: &mut impl FnMut(usize, F
             for j in 0..CHAINS {
                 let q = step(k + j, q1[j], q2[j]);
                 (q2[j], q1[j]) = (q1[j], q);
-                let v = q * il;
-                put(at - m0 - j, v * ss[j]);
-                put(at + m0 + j, v * cc[j]);
+                put(at - m0 - j, scaled(q * ss[j], il));
+                put(at + m0 + j, scaled(q * cc[j], il));
             }
         }
         // The next pass's first row, m0 + g, is in this head when there is one.
