@@ -93,26 +93,14 @@ pub fn apply_operator_slices(
         let live = (vectors - v).min(8);
         for l in 0..bands {
             let w = 2 * l + 1;
-            for (k, lane) in lanes[..w].iter_mut().enumerate() {
-                *lane = core::array::from_fn(|j| {
-                    if j < live {
-                        input[(v + j) * nn + l * l + k]
-                    } else {
-                        0.0
-                    }
-                });
-            }
+            gather(input, nn, v, live, l, &mut lanes[..w]);
             band_x8(
                 &op[operator_len(l)..operator_len(l + 1)],
                 w,
                 &lanes,
                 &mut res,
             );
-            for (k, r) in res[..w].iter().enumerate() {
-                for (j, &value) in r.iter().enumerate().take(live) {
-                    out[(v + j) * nn + l * l + k] = value;
-                }
-            }
+            scatter(&res[..w], nn, v, live, l, out);
         }
         v += 8;
     }
@@ -369,15 +357,7 @@ pub fn rotate_zxzxz_slices(
         }));
         for l in 0..bands {
             let w = 2 * l + 1;
-            for (k, lane) in lanes_in[..w].iter_mut().enumerate() {
-                *lane = core::array::from_fn(|j| {
-                    if j < live {
-                        input[(v + j) * nn + l * l + k]
-                    } else {
-                        0.0
-                    }
-                });
-            }
+            gather(input, nn, v, live, l, &mut lanes_in[..w]);
             zxzxz_band_x4(
                 x90,
                 &lanes,
@@ -387,13 +367,51 @@ pub fn rotate_zxzxz_slices(
                 &mut bufs,
                 Some(&mut wide),
             );
-            for (k, r) in lanes_out[..w].iter().enumerate() {
-                for (j, &value) in r.iter().enumerate().take(live) {
-                    out[(v + j) * nn + l * l + k] = value;
-                }
-            }
+            scatter(&lanes_out[..w], nn, v, live, l, out);
         }
         v += 4;
     }
     Ok(())
+}
+
+// ---- Batches of vectors ----------------------------------------------------------------------
+
+/// Band `l` of vectors `v .. v + live` (each `nn` long, one after another in `input`) into
+/// lanes: `lanes[k][j]` is coefficient `l² + k` of vector `v + j`, zero beyond `live`.
+#[inline(always)]
+fn gather<const N: usize>(
+    input: &[f32],
+    nn: usize,
+    v: usize,
+    live: usize,
+    l: usize,
+    lanes: &mut [[f32; N]],
+) {
+    for (k, lane) in lanes.iter_mut().enumerate() {
+        *lane = core::array::from_fn(|j| {
+            if j < live {
+                input[(v + j) * nn + l * l + k]
+            } else {
+                0.0
+            }
+        });
+    }
+}
+
+/// The inverse of [`gather`] for the `live` lanes: `lanes[k][j]` to coefficient `l² + k` of
+/// vector `v + j` in `out`.
+#[inline(always)]
+fn scatter<const N: usize>(
+    lanes: &[[f32; N]],
+    nn: usize,
+    v: usize,
+    live: usize,
+    l: usize,
+    out: &mut [f32],
+) {
+    for (k, r) in lanes.iter().enumerate() {
+        for (j, &value) in r.iter().enumerate().take(live) {
+            out[(v + j) * nn + l * l + k] = value;
+        }
+    }
 }
