@@ -207,8 +207,8 @@ pub const CP_QUERY_TOL: f32 = 1.0e-5;
 /// ([`SH_EVAL_MAX_BANDS`]). Input columns `[x, y, z]`, output columns `l² + l + m`. Binding 3
 /// is one `f32`: the band count. Not in [`ALL`]: run it with the harness's custom kernels.
 /// WGSL has no `f64`, and the scalar kernel's recurrence in `f32` loses accuracy like `l²`
-/// near the poles (a double characteristic root at `|cos θ| = 1`: `1e-5` near band 17,
-/// `4.8e-5` at band 29), so the GPU runs the same Legendre recurrence per order on the
+/// near the poles (a double characteristic root at `|cos θ| = 1`: `7.7e-6` at 16 bands on
+/// lavapipe, growing like `l²` beyond), so the GPU runs the same Legendre recurrence per order on the
 /// ratios `P_l^m(t)/P_l^m(1)` and their differences, with `1 − |cos θ|` formed without
 /// cancellation (derived in `sh_basis.wgsl`): its errors add instead. Its coefficients come
 /// from `sqrt` of the same rationals on the GPU. Tolerance: [`SH_EVAL_TOL`].
