@@ -257,9 +257,16 @@ pub fn eval_slices(
         8 => columns(x, y, z, 8, out),
         9 => columns(x, y, z, 9, out),
         10 => columns(x, y, z, 10, out),
-        _ => columns(x, y, z, bands, out),
+        _ => columns_any(x, y, z, bands, out),
     }
     Ok(())
+}
+
+/// [`columns`] for the band counts without straight-line code, out of line (inlined beside
+/// the ten constant-count copies it ran slower).
+#[inline(never)]
+fn columns_any(x: &[f32], y: &[f32], z: &[f32], bands: usize, out: &mut [f32]) {
+    columns(x, y, z, bands, out);
 }
 
 /// The loops of [`eval_slices`] (shapes checked by it).
