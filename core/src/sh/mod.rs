@@ -268,15 +268,14 @@ pub static SUB: [f64; MAX_BANDS] = table_sub();
 
 // ---- Evaluation --------------------------------------------------------------------------
 
-/// `d` normalised in `f64` (so the direction the recurrence sees is the input's to `3e-16`,
-/// not to the `6e-8` of an `f32` unit vector, which alone would cost `3e-6` at 30 bands);
-/// the zero vector → `+z`; NaN for a non-finite component.
+/// `d` normalised in `f64` (so the direction is the input's to `3e-16`, not to the `6e-8`
+/// of an `f32` unit vector, which alone would cost `3e-6` at 30 bands); the zero vector →
+/// `+z`; NaN for a non-finite component. The same vector as [`point`]`(d).normalized().p`,
+/// for the SH kernels that need the direction itself (convolution, irradiance).
 ///
 /// `r² = x² + y² + z²` of an `f32` vector cannot overflow or underflow in `f64`
 /// (`3·f32::MAX² ≈ 3.5e77`, the smallest subnormal squared `2e-90`), so no pre-scaling is
-/// needed; the direction is `d·(1/√r²)`: one square root, one division, three products, so
-/// that the SIMD twin ([`unit_direction`]'s lanes in `steradian_simd::sh`) performs the
-/// same correctly rounded operations and gets the same bits.
+/// needed; the direction is `d·(1/√r²)`: one square root, one division, three products.
 #[inline]
 pub fn unit_direction(d: Vec3) -> DVec3 {
     let (x, y, z) = (f64::from(d.x), f64::from(d.y), f64::from(d.z));
@@ -751,6 +750,25 @@ mod tests {
         ];
         for (k, (g, w)) in y.iter().zip(want).enumerate() {
             assert!((*g as f64 - w).abs() < 1e-6, "index {k}: {g} vs {w}");
+        }
+    }
+
+    #[test]
+    fn the_normalised_point_is_unit_direction() {
+        let same = |a: f64, b: f64| a.to_bits() == b.to_bits() || (a.is_nan() && b.is_nan());
+        let mut dirs = hard_directions();
+        dirs.extend(directions().iter().step_by(10).map(|d| *d * 3e-30));
+        dirs.extend([
+            Vec3::ZERO,
+            Vec3::splat(f32::MAX),
+            Vec3::new(f32::INFINITY, 0.0, 0.0),
+        ]);
+        for d in dirs {
+            let (u, p) = (unit_direction(d), point(d).normalized().p);
+            assert!(
+                same(u.x, p.x) && same(u.y, p.y) && same(u.z, p.z),
+                "{d:?}: {u:?} vs {p:?}"
+            );
         }
     }
 
