@@ -248,15 +248,15 @@ pub fn eval_slices(
     // Straight-line code for the band counts renderers use most, as the scalar kernel
     // (the count a constant: same operations, same bits).
     match bands {
-        2 => columns(x, y, z, 2, out),
-        3 => columns(x, y, z, 3, out),
-        4 => columns(x, y, z, 4, out),
-        5 => columns(x, y, z, 5, out),
-        6 => columns(x, y, z, 6, out),
-        7 => columns(x, y, z, 7, out),
-        8 => columns(x, y, z, 8, out),
-        9 => columns(x, y, z, 9, out),
-        10 => columns(x, y, z, 10, out),
+        2 => columns::<false>(x, y, z, 2, out),
+        3 => columns::<false>(x, y, z, 3, out),
+        4 => columns::<false>(x, y, z, 4, out),
+        5 => columns::<false>(x, y, z, 5, out),
+        6 => columns::<false>(x, y, z, 6, out),
+        7 => columns::<false>(x, y, z, 7, out),
+        8 => columns::<false>(x, y, z, 8, out),
+        9 => columns::<false>(x, y, z, 9, out),
+        10 => columns::<false>(x, y, z, 10, out),
         _ => columns_any(x, y, z, bands, out),
     }
     Ok(())
@@ -266,12 +266,16 @@ pub fn eval_slices(
 /// the ten constant-count copies it ran slower).
 #[inline(never)]
 fn columns_any(x: &[f32], y: &[f32], z: &[f32], bands: usize, out: &mut [f32]) {
-    columns(x, y, z, bands, out);
+    columns::<true>(x, y, z, bands, out);
 }
 
 /// The loops of [`eval_slices`] (shapes checked by it).
+///
+/// `OWN`: the store closure owns its copies of the row, the length and the output slice,
+/// so the loop does not reload them after each store; faster for the dynamic band counts
+/// (the loop), slower for the straight-line code (`steradian report --section sh`).
 #[inline(always)]
-fn columns(x: &[f32], y: &[f32], z: &[f32], bands: usize, out: &mut [f32]) {
+fn columns<const OWN: bool>(x: &[f32], y: &[f32], z: &[f32], bands: usize, out: &mut [f32]) {
     use slice_lanes::{L, N, narrow, unit_lanes};
     let len = x.len();
     // Whole groups of lanes: one store of `N` values per coefficient.
@@ -279,10 +283,18 @@ fn columns(x: &[f32], y: &[f32], z: &[f32], bands: usize, out: &mut [f32]) {
     let col = |v: &[f32], i: usize| L::new(core::array::from_fn(|k| f64::from(v[i + k])));
     for i in (0..whole).step_by(N) {
         let u = unit_lanes(col(x, i), col(y, i), col(z, i));
-        fill(u, bands, &mut |c, v| {
-            let at = c * len + i;
-            out[at..at + N].copy_from_slice(&narrow(v));
-        });
+        if OWN {
+            let dst = &mut *out;
+            fill(u, bands, &mut move |c, v| {
+                let at = c * len + i;
+                dst[at..at + N].copy_from_slice(&narrow(v));
+            });
+        } else {
+            fill(u, bands, &mut |c, v| {
+                let at = c * len + i;
+                out[at..at + N].copy_from_slice(&narrow(v));
+            });
+        }
     }
     // The tail, padded with `+z` and not written.
     if whole < len {
