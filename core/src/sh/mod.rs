@@ -411,6 +411,8 @@ fn step(k: usize, z: f64, r2: f64, q1: f64, q2: f64) -> f64 {
 ///
 /// `H` is the form: `false` skips the products by `r^−l`, all exactly 1 on a normalised
 /// point, which the compiler cannot see through the loop (same bits, fewer operations).
+// `l` is the band: it indexes the coefficient tables and the output as well as `il`.
+#[allow(clippy::needless_range_loop)]
 #[inline(always)]
 fn fill<const H: bool>(pt: Point, bands: usize, out: &mut [f32]) {
     let out = &mut out[..bands * bands];
@@ -418,9 +420,14 @@ fn fill<const H: bool>(pt: Point, bands: usize, out: &mut [f32]) {
         return;
     }
     let (x, y, z, r2, inv) = (pt.p.x, pt.p.y, pt.p.z, pt.r2, pt.inv);
-    // r^−l by `il_l = il_{l−1}·inv` from `il_0 = 1` (the order the generated code
-    // repeats): `il_m0` at the pass's first row, then the head's rows, then running.
-    let mut il_m0 = 1.0f64;
+    // r^−l by `il[l] = il[l−1]·inv` from `il[0] = 1` (the order the generated code
+    // repeats); unused, and so not formed, in the normalised form.
+    let mut il = [1.0f64; MAX_BANDS];
+    if H {
+        for l in 1..bands {
+            il[l] = il[l - 1] * inv;
+        }
+    }
     let (mut pmm, mut c, mut s) = (Y00_F64, 1.0f64, 0.0f64);
     let mut m0 = 0;
     while m0 < bands {
@@ -444,10 +451,6 @@ fn fill<const H: bool>(pt: Point, bands: usize, out: &mut [f32]) {
         // The first rows, one chain after the other: chain j starts at row m0 + j and
         // steps from row m0 + j + 2.
         let head = (m0 + g + 1).min(bands);
-        let mut ilh = [il_m0; MAX_GROUP + 1];
-        for r in 1..head - m0 {
-            ilh[r] = ilh[r - 1] * inv;
-        }
         for j in 0..g {
             let m = m0 + j;
             let (mut p1, mut p2) = (q1[j], 0.0);
@@ -462,18 +465,15 @@ fn fill<const H: bool>(pt: Point, bands: usize, out: &mut [f32]) {
                 if l > m {
                     (p2, p1) = (p1, q);
                 }
-                let il = ilh[l - m0];
                 let at = l * l + l;
-                out[at - m] = scaled::<H>(q * ss[j], il) as f32;
-                out[at + m] = scaled::<H>(q * cc[j], il) as f32;
+                out[at - m] = scaled::<H>(q * ss[j], il[l]) as f32;
+                out[at + m] = scaled::<H>(q * cc[j], il[l]) as f32;
             }
             (q1[j], q2[j]) = (p1, p2);
         }
         // The rest: every chain steps (only groups of `CHAINS` reach here: the last group,
         // of any other size, takes every remaining order, so its head ends at `bands`).
-        let mut il = ilh[head - 1 - m0];
         for l in head..bands {
-            il *= inv;
             let at = l * l + l;
             let k = tri(l, m0);
             let (a, ab) = (&A[k..k + CHAINS], &AB[k..k + CHAINS]);
@@ -481,18 +481,14 @@ fn fill<const H: bool>(pt: Point, bands: usize, out: &mut [f32]) {
             for j in 0..CHAINS {
                 let q = a[j] * z * q1[j] - ab[j] * r2 * q2[j];
                 (q2[j], q1[j]) = (q1[j], q);
-                sin[CHAINS - 1 - j] = scaled::<H>(q * ss[j], il) as f32;
-                cos[j] = scaled::<H>(q * cc[j], il) as f32;
+                sin[CHAINS - 1 - j] = scaled::<H>(q * ss[j], il[l]) as f32;
+                cos[j] = scaled::<H>(q * cc[j], il[l]) as f32;
             }
             // Orders m0 + 3 … m0 below the centre, m0 … m0 + 3 above (they meet at the
             // centre only for m0 = 0, where the cosine part, written last, is the value).
             let lo = at - m0 - (CHAINS - 1);
             out[lo..lo + CHAINS].copy_from_slice(&sin);
             out[at + m0..at + m0 + CHAINS].copy_from_slice(&cos);
-        }
-        // The next pass's first row, m0 + g, is in this head when there is one.
-        if m0 + g < bands {
-            il_m0 = ilh[g];
         }
         m0 += g;
     }

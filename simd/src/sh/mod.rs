@@ -130,15 +130,21 @@ fn form<F: F64Lanes>(u: [F; 5], bands: usize) -> [F; 5] {
 /// The loop of [`fill`] (band counts without straight-line code), on the point `u` of the
 /// form [`form`] chose; `H = false` skips the products by `r^−l = 1` (the scalar loop's
 /// `H`).
+// `l` is the band: it indexes the coefficient tables and the output as well as `il`.
+#[allow(clippy::needless_range_loop)]
 #[inline(always)]
 fn fill_loop<const H: bool, F: F64Lanes>(u: [F; 5], bands: usize, put: &mut impl FnMut(usize, F)) {
     let scaled = |v: F, il: F| if H { v * il } else { v };
     let [x, y, z, r2, inv] = u;
     let sp = F::splat;
     let step = |k: usize, q1: F, q2: F| sp(A[k]) * z * q1 - sp(AB[k]) * r2 * q2;
-    // r^−l as the scalar kernel's `il_l = il_{l−1}·inv`: at the pass's first row, the
-    // head's rows, then running.
-    let mut il_m0 = sp(1.0);
+    // r^−l as the scalar kernel's `il[l] = il[l−1]·inv`; unused in the normalised form.
+    let mut il = [sp(1.0); MAX_BANDS];
+    if H {
+        for l in 1..bands {
+            il[l] = il[l - 1] * inv;
+        }
+    }
     let (mut pmm, mut c, mut s) = (Y00_F64, sp(1.0), sp(0.0));
     let mut m0 = 0;
     while m0 < bands {
@@ -159,10 +165,6 @@ fn fill_loop<const H: bool, F: F64Lanes>(u: [F; 5], bands: usize, put: &mut impl
             });
         }
         let head = (m0 + g + 1).min(bands);
-        let mut ilh = [il_m0; MAX_GROUP + 1];
-        for r in 1..head - m0 {
-            ilh[r] = ilh[r - 1] * inv;
-        }
         for j in 0..g {
             let m = m0 + j;
             let (mut p1, mut p2) = (q1[j], sp(0.0));
@@ -177,28 +179,21 @@ fn fill_loop<const H: bool, F: F64Lanes>(u: [F; 5], bands: usize, put: &mut impl
                 if l > m {
                     (p2, p1) = (p1, q);
                 }
-                let il = ilh[l - m0];
                 let at = l * l + l;
-                put(at - m, scaled(q * ss[j], il));
-                put(at + m, scaled(q * cc[j], il));
+                put(at - m, scaled(q * ss[j], il[l]));
+                put(at + m, scaled(q * cc[j], il[l]));
             }
             (q1[j], q2[j]) = (p1, p2);
         }
-        let mut il = ilh[head - 1 - m0];
         for l in head..bands {
-            il = il * inv;
             let at = l * l + l;
             let k = tri(l, m0);
             for j in 0..CHAINS {
                 let q = step(k + j, q1[j], q2[j]);
                 (q2[j], q1[j]) = (q1[j], q);
-                put(at - m0 - j, scaled(q * ss[j], il));
-                put(at + m0 + j, scaled(q * cc[j], il));
+                put(at - m0 - j, scaled(q * ss[j], il[l]));
+                put(at + m0 + j, scaled(q * cc[j], il[l]));
             }
-        }
-        // The next pass's first row, m0 + g, is in this head when there is one.
-        if m0 + g < bands {
-            il_m0 = ilh[g];
         }
         m0 += g;
     }
