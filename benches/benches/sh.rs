@@ -63,7 +63,8 @@ fn eval(c: &mut Criterion) {
 }
 
 /// Rotation per vector: the ZXZXZ path (scalar and SIMD) and the built operator's
-/// application, at 3, 5, 10 and 30 bands, and the operator's build (what a batch sharing one rotation pays once).
+/// application, at 3, 5, 10 and 30 bands, and the operator's build (what a batch sharing one
+/// rotation pays once).
 fn rotation(c: &mut Criterion) {
     use steradian_core::sh::rotate::{Operator, Rotation, Rotator};
     let rot = Rotation::from_axis_angle(Vec3::new(0.3, -0.5, 0.8), 1.1).unwrap();

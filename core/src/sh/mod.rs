@@ -50,8 +50,8 @@
 //! `Q_{m+1}^m = √(2m+3)·z·Q_m^m` and `Q_l^m = (a·z)·Q_{l−1}^m − (a·b·r²)·Q_{l−2}^m`; and
 //! `r^m·C_m(x/r, y/r) = C_m(x, y)`. So the recurrence on the raw point gives `r^l·Y_l^m`,
 //! and each value times `r^−l` is `Y_l^m` (on the unit sphere, `r = 1`, it is the plain
-//! recurrence). So the recurrence need not wait for `1/r`: the square root and the division run
-//! beside it, and meet it in one product per value. For a few bands the evaluation's time
+//! recurrence). The recurrence therefore need not wait for `1/r`: the square root and the
+//! division run beside it, and meet it in one product per value. For a few bands the evaluation's time
 //! is that latency, and the homogeneous form ([`point`], through
 //! [`HOMOGENEOUS_MAX_BANDS`] = 6) is faster; for more bands it is bound by its operation
 //! count, and the normalised form ([`Point::normalized`]: the same code on `(x, y, z)/r`
@@ -397,7 +397,8 @@ fn step(k: usize, z: f64, r2: f64, q1: f64, q2: f64) -> f64 {
 /// Shared by the fixed-size and the dynamic entry points, so both give the same bits.
 ///
 /// The recurrence runs in `f64`, one rounding to `f32` per output (module docs,
-/// "Accuracy"); each value is `q·S_m`, then `q·C_m`, times `r^−l` (the one product that waits for the normalisation).
+/// "Accuracy"); each value is `q·S_m`, then `q·C_m`, times `r^−l` (the one product that
+/// waits for the normalisation).
 ///
 /// **[`CHAINS`] orders at a time.** The recurrence in `l` is a chain of dependent
 /// operations per order `m`, so the orders `m0 .. m0 + 3` run in the same loop over `l`,

@@ -5,9 +5,8 @@
 //
 // Not the scalar kernel's recurrence: in f32, its three-term recurrence in l has a double
 // characteristic root at the poles (|cos θ| → 1), where rounding and the f32 error of cos θ
-// grow like l² (7.7e-6 at 16 bands on lavapipe, beyond 1e-5 from band 17). Here, per
-// order m, with t = |cos θ| and u = 1 − t formed without cancellation as
-// (x² + y²)/(r(r + |z|)), and P̃_l^m(t) = P_l^m(t)/sin^m θ (a polynomial in t):
+// grow like l². Here, per order m, with t = |cos θ| and u = 1 − t formed without
+// cancellation as (x² + y²)/(r(r + |z|)), and P̃_l^m(t) = P_l^m(t)/sin^m θ (a polynomial in t):
 //   g_l = P̃_l^m(t)/P̃_l^m(1) (so g_m = 1, g_{m+1} = t, g_l(1) = 1),
 //   (l + m)·g_l = (2l − 1)·t·g_{l−1} − (l − m − 1)·g_{l−2} (the Legendre recurrence divided
 //   by P̃_l^m(1)/P̃_{l−1}^m(1) = (l + m)/(l − m)), run on the differences e_l = g_l − g_{l−1}:

@@ -207,11 +207,11 @@ pub const CP_QUERY_TOL: f32 = 1.0e-5;
 /// ([`SH_EVAL_MAX_BANDS`]). Input columns `[x, y, z]`, output columns `l² + l + m`. Binding 3
 /// is one `f32`: the band count. Not in [`ALL`]: run it with the harness's custom kernels.
 /// WGSL has no `f64`, and the scalar kernel's recurrence in `f32` loses accuracy like `l²`
-/// near the poles (a double characteristic root at `|cos θ| = 1`: `7.7e-6` at 16 bands on
-/// lavapipe, growing like `l²` beyond), so the GPU runs the same Legendre recurrence per order on the
-/// ratios `P_l^m(t)/P_l^m(1)` and their differences, with `1 − |cos θ|` formed without
-/// cancellation (derived in `sh_basis.wgsl`): its errors add instead. Its coefficients come
-/// from `sqrt` of the same rationals on the GPU. Tolerance: [`SH_EVAL_TOL`].
+/// near the poles (a double characteristic root at `|cos θ| = 1`), so the GPU runs the same
+/// Legendre recurrence per order on the ratios `P̃_l^m(t)/P̃_l^m(1)` (`P̃ = P/sin^m θ`) and
+/// their differences, with `1 − |cos θ|` formed without cancellation (derived in
+/// `sh_basis.wgsl`): its errors add instead. Its coefficients come from `sqrt` of the same
+/// rationals on the GPU. Tolerance: [`SH_EVAL_TOL`].
 pub const SH_EVAL: &str = concat!(
     include_str!("batch.wgsl"),
     include_str!("../sh/sh_basis.wgsl"),
@@ -222,8 +222,8 @@ pub const SH_EVAL: &str = concat!(
 pub const SH_EVAL_MAX_BANDS: usize = 32;
 /// Absolute difference allowed between [`SH_EVAL`] and `sh::eval_into` per value, for up
 /// to [`SH_EVAL_MAX_BANDS`] bands (the values are at most `√((2l+1)/(2π))` ≈ 3.2 in size).
-/// Lavapipe: `8.0e-7` at 9 bands, `1.4e-6` at 16, `3.0e-6` at 30 (harness test
-/// `tests/sh_gpu.rs`, which prints them).
+/// Lavapipe: within `1e-6` through 9 bands, `2e-6` through 16, `4e-6` through 32 (asserted
+/// there by the harness test `tests/sh_gpu.rs`, which prints the measured values).
 pub const SH_EVAL_TOL: f32 = 1.0e-5;
 
 /// The SH coefficients of spherical caps (`sh::cap::coefficients_into`) in `f32`, for
@@ -241,8 +241,8 @@ pub const SH_CAP: &str = concat!(
 /// Absolute difference allowed between [`SH_CAP`] and `sh::cap::coefficients_into` per
 /// coefficient, in units of the cap's solid angle `4π·sin²(a/2)` (every coefficient of band
 /// `l` is at most `√((2l+1)/4π)` of it), for half-angles from `1e-4` to `π`. Lavapipe:
-/// `8.4e-7` at 9 bands, `1.3e-6` at 16, `3.1e-6` at 30, the basis's error (harness test
-/// `tests/sh_gpu.rs`, which prints them).
+/// within `1e-6` through 9 bands, `2e-6` through 16, `4e-6` through 32, the basis's error
+/// (asserted there by the harness test `tests/sh_gpu.rs`, which prints the measured values).
 pub const SH_CAP_TOL: f32 = 1.0e-5;
 
 /// The built SH rotation operator (`sh::rotate::apply_operator`, the many-vectors path of
@@ -339,8 +339,8 @@ pub const SH_IRRADIANCE: &str = concat!(
 );
 /// Absolute difference allowed between [`SH_IRRADIANCE`] and `sh::irradiance::irradiance`,
 /// per unit of `Σ_l |A_l|·Σ_m |L_l^m|` (the basis's own tolerance [`SH_EVAL_TOL`] carried
-/// through the sum). Lavapipe: below `1e-7` through 32 bands (harness test
-/// `tests/sh_gpu.rs`, which prints them).
+/// through the sum). Lavapipe: within `1e-7` through 32 bands (asserted there by the harness
+/// test `tests/sh_gpu.rs`, which prints the measured values).
 pub const SH_IRRADIANCE_TOL: f32 = 1.0e-5;
 
 /// RSL shading of one point per invocation (`shade::shade` with an isotropic BRDF SAT and
