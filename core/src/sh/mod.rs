@@ -776,23 +776,33 @@ mod tests {
     fn both_forms_within_the_bound_at_any_length() {
         let mut worst = 0.0f64;
         for n in 1..=HOMOGENEOUS_MAX_BANDS + 1 {
-            for d in directions().into_iter().step_by(4) {
-                for scale in [1.0f32, 1e-40, 1e-20, 3e18, 1e38] {
-                    let v = d * scale;
-                    let got = eval(v, n);
-                    let want = reference::eval([v.x as f64, v.y as f64, v.z as f64], n);
-                    for l in 0..n {
-                        for m in -(l as isize)..=l as isize {
-                            let i = index(l, m);
-                            let err = (got[i] as f64 - want[i]).abs();
-                            worst = worst.max(err);
-                            assert!(
-                                err <= eval_abs_error(l) as f64,
-                                "{v:?} n {n} ({l}, {m}): {} vs {}",
-                                got[i],
-                                want[i]
-                            );
-                        }
+            let tiny = f32::from_bits(1);
+            // The ends of the range the docs quote: the smallest subnormal and f32::MAX.
+            let extremes = [
+                Vec3::new(tiny, 0.0, 0.0),
+                Vec3::new(0.0, -tiny, tiny),
+                Vec3::splat(tiny),
+                Vec3::new(f32::MAX, 0.0, 0.0),
+                Vec3::new(f32::MAX, -f32::MAX, f32::MAX),
+            ];
+            let scaled = directions()
+                .into_iter()
+                .step_by(4)
+                .flat_map(|d| [1.0f32, 1e-40, 1e-20, 3e18, 1e38].map(|s| d * s));
+            for v in scaled.chain(extremes) {
+                let got = eval(v, n);
+                let want = reference::eval([v.x as f64, v.y as f64, v.z as f64], n);
+                for l in 0..n {
+                    for m in -(l as isize)..=l as isize {
+                        let i = index(l, m);
+                        let err = (got[i] as f64 - want[i]).abs();
+                        worst = worst.max(err);
+                        assert!(
+                            err <= eval_abs_error(l) as f64,
+                            "{v:?} n {n} ({l}, {m}): {} vs {}",
+                            got[i],
+                            want[i]
+                        );
                     }
                 }
             }
