@@ -221,16 +221,19 @@ fn check_zxzxz(x90: &[f32], rots: &[sh::rotate::Rotation], bands: usize, vectors
 }
 
 /// Rotations of every path of the scalar kernel: general ones, about `z` (the identity
-/// included), half-turns about horizontal axes, and the near-singular Euler angles.
+/// included), half-turns about horizontal axes, and the near-singular Euler angles; each
+/// path is present (asserted).
 fn every_kind_of_rotation(rng: &mut Rng) -> Vec<sh::rotate::Rotation> {
-    use sh::rotate::Rotation;
+    use sh::rotate::{Euler, Rotation};
     let axis_angle = |a: Vec3, t: f32| Rotation::from_axis_angle(a, t).unwrap();
     let mut rots = vec![
         Rotation::identity(),
         axis_angle(Vec3::Z, 0.7),
         axis_angle(-Vec3::Z, 3.0),
-        axis_angle(Vec3::X, core::f32::consts::PI),
-        axis_angle(Vec3::new(1.0, 1.0, 0.0), core::f32::consts::PI),
+        // Half-turns about horizontal axes, exactly (an f32 angle of π is not one): x, and
+        // the diagonal of the xy-plane.
+        Rotation::new([[1.0, 0.0, 0.0], [0.0, -1.0, 0.0], [0.0, 0.0, -1.0]]).unwrap(),
+        Rotation::new([[0.0, 1.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, -1.0]]).unwrap(),
         axis_angle(Vec3::X, 1e-6),
         axis_angle(Vec3::new(0.0, 1.0, 1e-6), 2.0),
         axis_angle(Vec3::Y, core::f32::consts::PI - 1e-6),
@@ -238,6 +241,15 @@ fn every_kind_of_rotation(rng: &mut Rng) -> Vec<sh::rotate::Rotation> {
     for _ in 0..16 {
         rots.push(axis_angle(rng.dir(), rng.range(-3.2, 3.2)));
     }
+    let path = |k: usize| match rots[k].euler() {
+        Euler::AboutZ(_) => 0,
+        Euler::HalfTurn(_) => 1,
+        Euler::General { .. } => 2,
+    };
+    assert_eq!(
+        (0..rots.len()).map(path).collect::<Vec<_>>()[..9],
+        [0, 0, 0, 1, 1, 2, 2, 2, 2]
+    );
     rots
 }
 
@@ -245,7 +257,8 @@ fn every_kind_of_rotation(rng: &mut Rng) -> Vec<sh::rotate::Rotation> {
 fn zxzxz_lanes_equal_the_scalar_kernel() {
     let mut rng = Rng(0x2a2a);
     let kinds = every_kind_of_rotation(&mut rng);
-    for bands in [0usize, 1, 2, 3, 5, 10, 12, 30] {
+    // 40 bands: beyond the 32 whose blocks the batch widens to f64, the f32 block is read.
+    for bands in [0usize, 1, 2, 3, 5, 10, 12, 30, 40] {
         let nn = bands * bands;
         let mut x90_table = vec![0.0f32; sh::rotate::operator_len(bands)];
         let mut scratch = vec![0.0f64; sh::rotate::scratch_len(bands)];
@@ -280,6 +293,51 @@ fn zxzxz_lanes_equal_the_scalar_kernel() {
                     for rot in [kinds[9], kinds[3]] {
                         check_zxzxz(&x90_table, &vec![rot; rows.len()], bands, &rows);
                     }
+                }
+            }
+        }
+    }
+}
+
+/// The four-lane entry point (which reads the f32 block directly) lane by lane against the
+/// scalar kernel, every kind of rotation in every lane, special values in one lane.
+#[test]
+fn zxzxz_x4_lanes_equal_the_scalar_kernel() {
+    use steradian_simd::sh::rotate::rotate_zxzxz_x4;
+    let mut rng = Rng(0x2b2b);
+    let kinds = every_kind_of_rotation(&mut rng);
+    for bands in [1usize, 2, 3, 7, 10, 33] {
+        let nn = bands * bands;
+        let mut x90 = vec![0.0f32; sh::rotate::operator_len(bands)];
+        let mut scratch = vec![0.0f64; sh::rotate::scratch_len(bands)];
+        sh::rotate::x90_into(bands, &mut x90, &mut scratch).unwrap();
+        for (pass, sp) in [0.0f32]
+            .iter()
+            .chain(SPECIALS.iter().step_by(5))
+            .enumerate()
+        {
+            let rots: [&sh::rotate::Rotation; 4] =
+                core::array::from_fn(|j| &kinds[(pass * 4 + j * 3) % kinds.len()]);
+            let mut vectors: Vec<Vec<f32>> = (0..4)
+                .map(|_| (0..nn).map(|_| rng.range(-2.0, 2.0)).collect())
+                .collect();
+            if pass > 0 {
+                vectors[pass % 4][nn / 2] = *sp;
+            }
+            let input: Vec<[f32; 4]> = (0..nn)
+                .map(|k| core::array::from_fn(|j| vectors[j][k]))
+                .collect();
+            let mut out = vec![[0.0f32; 4]; nn];
+            rotate_zxzxz_x4(&x90, rots, bands, &input, &mut out).expect("valid shapes");
+            let mut want = vec![0.0f32; nn];
+            for (j, v) in vectors.iter().enumerate() {
+                sh::rotate::rotate_zxzxz(&x90, rots[j], bands, v, &mut want).unwrap();
+                for (k, w) in want.iter().enumerate() {
+                    assert!(
+                        same(out[k][j], *w),
+                        "bands {bands} pass {pass} lane {j} k {k}: {} vs {w}",
+                        out[k][j]
+                    );
                 }
             }
         }

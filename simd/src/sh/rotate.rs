@@ -70,21 +70,12 @@ pub fn apply_operator_slices(
     input: &[f32],
     out: &mut [f32],
 ) -> Result<(), Error> {
-    check_shape(bands, usize::MAX)?;
-    let nn = bands * bands;
-    if nn == 0 {
+    let vectors = batch_len(bands, input, out)?;
+    if vectors == 0 {
         return Ok(());
     }
-    if !input.len().is_multiple_of(nn) || out.len() != input.len() {
-        return Err(Error::OutOfRange {
-            what: "rotation batch length (a whole number of n² vectors, out as long as in)",
-            value: input.len() as f32,
-            min: 0.0,
-            max: f32::INFINITY,
-        });
-    }
     check_operator(op, bands)?;
-    let vectors = input.len() / nn;
+    let nn = bands * bands;
     // One band of eight vectors at a time, on the stack (at most 2·MAX_BANDS − 1 lanes).
     let mut lanes = [[0.0f32; 8]; 2 * steradian_core::sh::MAX_BANDS - 1];
     let mut res = [[0.0f32; 8]; 2 * steradian_core::sh::MAX_BANDS - 1];
@@ -188,27 +179,26 @@ struct Lanes4 {
 
 impl Lanes4 {
     fn new(rots: [&Rotation; 4]) -> Self {
-        let one = [1.0, 0.0];
-        let pick = |f: &dyn Fn(&Euler) -> [f64; 2]| -> [f64x4; 2] {
-            let v = rots.map(|r| f(&r.euler()));
-            [f64x4::new(v.map(|c| c[0])), f64x4::new(v.map(|c| c[1]))]
-        };
-        let general_part = |k: usize| {
-            move |e: &Euler| match *e {
-                Euler::General { alpha, beta, gamma } => [alpha, beta, gamma][k],
-                _ => one,
+        let (mut g, mut exact) = ([[[1.0, 0.0]; 4]; 3], [[1.0, 0.0]; 4]);
+        let (mut half_turn, mut general) = ([false; 4], [false; 4]);
+        for (j, r) in rots.iter().enumerate() {
+            match r.euler() {
+                Euler::General { alpha, beta, gamma } => {
+                    (g[0][j], g[1][j], g[2][j]) = (alpha, beta, gamma);
+                    general[j] = true;
+                }
+                Euler::AboutZ(t) => exact[j] = t,
+                Euler::HalfTurn(t) => (exact[j], half_turn[j]) = (t, true),
             }
-        };
+        }
+        let lanes = |v: [[f64; 2]; 4]| [f64x4::new(v.map(|c| c[0])), f64x4::new(v.map(|c| c[1]))];
         Lanes4 {
-            alpha: pick(&general_part(0)),
-            beta: pick(&general_part(1)),
-            gamma: pick(&general_part(2)),
-            exact: pick(&|e: &Euler| match *e {
-                Euler::AboutZ(t) | Euler::HalfTurn(t) => t,
-                Euler::General { .. } => one,
-            }),
-            half_turn: rots.map(|r| matches!(r.euler(), Euler::HalfTurn(_))),
-            general: rots.map(|r| matches!(r.euler(), Euler::General { .. })),
+            alpha: lanes(g[0]),
+            beta: lanes(g[1]),
+            gamma: lanes(g[2]),
+            exact: lanes(exact),
+            half_turn,
+            general,
         }
     }
 }
@@ -258,7 +248,7 @@ fn zxzxz_band_x4(
     input: &[[f32; 4]],
     out: &mut [[f32; 4]],
     [a, b, e]: &mut [[f64x4; 2 * steradian_core::sh::MAX_BANDS - 1]; 3],
-    wide: Option<&mut [f64]>,
+    widened: Option<&mut [f64]>,
 ) {
     let w = 2 * l + 1;
     for (t, v) in a[..w].iter_mut().zip(&input[..w]) {
@@ -282,15 +272,15 @@ fn zxzxz_band_x4(
     if lanes.general.contains(&true) {
         let block = &x90[operator_len(l)..operator_len(l + 1)];
         rotate_z_x4(l, lanes.gamma, a);
-        if let Some(wide) = wide.filter(|b| b.len() >= w * w) {
+        if let Some(widened) = widened.filter(|b| b.len() >= w * w) {
             // The block widened to f64 once for both products: the same values, and each
             // entry's broadcast is then a plain load.
-            for (d, &s) in wide.iter_mut().zip(block) {
+            for (d, &s) in widened.iter_mut().zip(block) {
                 *d = f64::from(s);
             }
-            apply_block_x4(&wide[..w * w], w, false, a, b);
+            apply_block_x4(&widened[..w * w], w, false, a, b);
             rotate_z_x4(l, lanes.beta, b);
-            apply_block_x4(&wide[..w * w], w, true, b, a);
+            apply_block_x4(&widened[..w * w], w, true, b, a);
         } else {
             apply_block_x4(block, w, false, a, b);
             rotate_z_x4(l, lanes.beta, b);
@@ -318,24 +308,19 @@ pub fn rotate_zxzxz_slices(
     input: &[f32],
     out: &mut [f32],
 ) -> Result<(), Error> {
-    check_shape(bands, usize::MAX)?;
-    let nn = bands * bands;
-    let vectors = input.len().checked_div(nn).unwrap_or(0);
-    if (nn > 0 && !input.len().is_multiple_of(nn))
-        || out.len() != input.len()
-        || (nn > 0 && rots.len() != vectors)
-    {
-        return Err(Error::OutOfRange {
-            what: "rotation batch length (a whole number of n² vectors, out as long as in, \
-                   one rotation per vector)",
-            value: input.len() as f32,
-            min: 0.0,
-            max: f32::INFINITY,
-        });
-    }
-    if nn == 0 {
+    let vectors = batch_len(bands, input, out)?;
+    if vectors == 0 {
         return Ok(());
     }
+    if rots.len() != vectors {
+        return Err(Error::OutOfRange {
+            what: "rotations of a batch (one per vector)",
+            value: rots.len() as f32,
+            min: vectors as f32,
+            max: vectors as f32,
+        });
+    }
+    let nn = bands * bands;
     if rots
         .iter()
         .any(|r| matches!(r.euler(), Euler::General { .. }))
@@ -347,8 +332,9 @@ pub fn rotate_zxzxz_slices(
     let mut lanes_in = [[0.0f32; 4]; W];
     let mut lanes_out = [[0.0f32; 4]; W];
     let identity = Rotation::identity();
-    // The widened blocks of up to 32 bands (w ≤ 63), reused by every pass.
-    let mut wide = [0.0f64; 63 * 63];
+    // Room for one band's block widened to f64 (up to 32 bands, w ≤ 63), rewritten by each
+    // pass for both of its products; beyond, the f32 block is read directly.
+    let mut widened = [0.0f64; 63 * 63];
     let mut v = 0;
     while v < vectors {
         let live = (vectors - v).min(4);
@@ -365,7 +351,7 @@ pub fn rotate_zxzxz_slices(
                 &lanes_in,
                 &mut lanes_out,
                 &mut bufs,
-                Some(&mut wide),
+                Some(&mut widened),
             );
             scatter(&lanes_out[..w], nn, v, live, l, out);
         }
@@ -375,6 +361,25 @@ pub fn rotate_zxzxz_slices(
 }
 
 // ---- Batches of vectors ----------------------------------------------------------------------
+
+/// The number of `bands²`-long vectors in `input`, checked: `bands ≤ MAX_BANDS`, `input` a
+/// whole number of vectors and `out` as long (0 for 0 bands).
+fn batch_len(bands: usize, input: &[f32], out: &[f32]) -> Result<usize, Error> {
+    check_shape(bands, usize::MAX)?;
+    let nn = bands * bands;
+    if nn == 0 {
+        return Ok(0);
+    }
+    if !input.len().is_multiple_of(nn) || out.len() != input.len() {
+        return Err(Error::OutOfRange {
+            what: "rotation batch length (a whole number of n² vectors, out as long as in)",
+            value: input.len() as f32,
+            min: 0.0,
+            max: f32::INFINITY,
+        });
+    }
+    Ok(input.len() / nn)
+}
 
 /// Band `l` of vectors `v .. v + live` (each `nn` long, one after another in `input`) into
 /// lanes: `lanes[k][j]` is coefficient `l² + k` of vector `v + j`, zero beyond `live`.
