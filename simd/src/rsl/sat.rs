@@ -2,11 +2,13 @@
 //!
 //! [`box_sum`] performs the operations of `steradian_core::rsl::sat::SatView::box_sum` lane-wise:
 //! the ordering and clipping of the corners with comparisons and selects, `floor`, the
-//! exact fractions, the sixteen table reads (scalar loads: `wide` has no gather), the 27
-//! exact `i64` subtractions in `i64x8`, the nine `i64 → f64` conversions, the `f64`
-//! combination in the scalar kernel's order (no fused multiply-add), the scaling by the
-//! quantum and the one rounding to `f32`. So every lane is **bit-identical** to the scalar
-//! kernel, NaN lanes included (NaN exactly where a corner is NaN).
+//! exact fractions, the sixteen table reads (eight adjacent pairs per lane, staged by a
+//! plain loop over the lanes, which the compiler turns into gathers where the target has
+//! them: `wide` has none), the 27 exact `i64` subtractions in `i64x8`, the nine
+//! `i64 → f64` conversions, the `f64` combination in the scalar kernel's order (no fused
+//! multiply-add), the scaling by the quantum and the one rounding to `f32`. So every lane
+//! is **bit-identical** to the scalar kernel, NaN lanes included (NaN exactly where a
+//! corner is NaN).
 
 use steradian_core::rsl::sat::{SatView, square_half_side};
 use wide::{f32x8, f64x8, i64x8};
@@ -44,12 +46,6 @@ fn indices(x: f32x8) -> [usize; 8] {
 #[inline(always)]
 fn widen(x: f32x8) -> f64x8 {
     f64x8::new(x.to_array().map(f64::from))
-}
-
-/// `sums[idx[k]]` in lane `k`, 0 past the end (one lane-wise load).
-#[inline(always)]
-fn gather(sums: &[i64], idx: [usize; 8]) -> i64x8 {
-    i64x8::new(idx.map(|i| sums.get(i).copied().unwrap_or(0)))
 }
 
 /// Eight box sums: lane `k` is `sat.box_sum(u0[k], v0[k], u1[k], v1[k])`, bit-identical.
@@ -97,20 +93,35 @@ pub fn box_sum(sat: &SatView<'_>, u0: f32x8, v0: f32x8, u1: f32x8, v1: f32x8) ->
         let h1 = sat.height() + 1;
         let (bl0, bl1) = (b0.to_array(), b1.to_array());
         let off = |l: usize| l.min(h1) * w1;
-        let next = |j: usize, b: f32| if b != 0.0 { j.saturating_add(1) } else { j };
-        let rows: [[usize; 8]; 4] = [
-            j0.map(off),
-            j1.map(off),
-            core::array::from_fn(|k| off(next(j0[k], bl0[k]))),
-            core::array::from_fn(|k| off(next(j1[k], bl1[k]))),
-        ];
+        // Rows `J0`, `J1`, and `J + 1` where the fraction is non-zero, else `J` again
+        // (`J < 2²⁴`: exact integers from `f32` lanes, so `J + 1` does not overflow).
+        let mut rows = [[0usize; 8]; 4];
+        for k in 0..8 {
+            let (a, b) = (j0[k], j1[k]);
+            rows[0][k] = off(a);
+            rows[1][k] = off(b);
+            rows[2][k] = off(a + usize::from(bl0[k] != 0.0));
+            rows[3][k] = off(b + usize::from(bl1[k] != 0.0));
+        }
         let cols: [[usize; 8]; 2] = [i0.map(|i| i.min(wl)), i1.map(|i| i.min(wl))];
-        let load = |r: usize, c: usize, dc: usize| {
-            gather(sums, core::array::from_fn(|k| rows[r][k] + cols[c][k] + dc))
-        };
-        let row = |r: usize| -> [i64x8; 4] {
-            [load(r, 0, 0), load(r, 0, 1), load(r, 1, 0), load(r, 1, 1)]
-        };
+        // st[4·row + col][lane], each row's two column pairs read as pairs (a column index
+        // is at most `width − 1`, so a pair never leaves its row; a row past the table reads
+        // as zeros).
+        let mut st = [[0i64; 8]; 16];
+        for k in 0..8 {
+            for (r, rk) in rows.iter().enumerate() {
+                for (c, ck) in cols.iter().enumerate() {
+                    let at = rk[k] + ck[k];
+                    let [x, y] = match sums.get(at..at + 2) {
+                        Some(&[x, y]) => [x, y],
+                        _ => [0, 0],
+                    };
+                    st[4 * r + 2 * c][k] = x;
+                    st[4 * r + 2 * c + 1][k] = y;
+                }
+            }
+        }
+        let row = |r: usize| -> [i64x8; 4] { core::array::from_fn(|c| i64x8::new(st[4 * r + c])) };
         let (r0, r1, r0p, r1p) = (row(0), row(1), row(2), row(3));
         let d = |l: [i64x8; 4], m: [i64x8; 4]| -> [i64x8; 3] {
             [
