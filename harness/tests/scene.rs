@@ -422,7 +422,9 @@ fn hvls_carry_the_light_power() {
 
 /// The `hvl` method on a small `room` against the path tracer with one bounce: within the
 /// bounds measured here (RMSE of the tone-mapped image 0.035, the HVL paper's 0.039 on its
-/// scene), and better than the direct light alone and than HVLs without visibility.
+/// scene), and better than the direct light alone, than HVLs without visibility and than
+/// receivers without their glossy tables (the glossy sphere then misses the indirect
+/// highlights of the walls).
 #[test]
 fn hvl_method_against_the_path_tracer_on_a_small_room() {
     use steradian_harness::scene::hvl;
@@ -440,14 +442,29 @@ fn hvl_method_against_the_path_tracer_on_a_small_room() {
         &hidden,
     )
     .0);
+    let diffuse_only = m(&hvl::render(s, &hvl::Options { glossy: false, ..d }, &hidden).0);
+    // The README's table size for the room's Phong 40.
+    let g = hvl::Glossy::build(s);
+    let sizes: Vec<(usize, usize)> = g
+        .parts
+        .iter()
+        .flatten()
+        .map(|p| (p.bands, p.samples))
+        .collect();
+    assert_eq!(sizes, [(16, 90)]);
     let direct = m(&lobes::render(s, &d.direct, &hidden).0);
-    eprintln!("hvl {with:?}\nno visibility {without:?}\ndirect {direct:?}");
+    eprintln!(
+        "hvl {with:?}\nno visibility {without:?}\ndiffuse receivers only {diffuse_only:?}\n\
+         direct {direct:?}"
+    );
     assert!(with.rmse < 0.035, "RMSE {}", with.rmse);
     assert!(
         with.mean_abs_over_max < 0.003 + 4.0 * with.reference_noise_over_max,
         "{with:?}"
     );
     assert!(with.mean_abs_over_max < without.mean_abs_over_max);
+    assert!(with.mean_abs_over_max < diffuse_only.mean_abs_over_max);
+    assert!(with.rel_l2 < diffuse_only.rel_l2);
     assert!(with.mean_abs_over_max < direct.mean_abs_over_max);
     assert!(with.rmse < direct.rmse);
 }

@@ -20,6 +20,7 @@
 //! fewest views (from 16, 23, 30, 45, 90, 180) whose linear interpolation misses the
 //! coefficients at the midpoints by at most `target/10` of their norm.
 
+use rayon::prelude::*;
 use steradian_core::sh::brdf::{TABLE_NAME, stored};
 use steradian_core::table::{HEADER_LEN, Spec, encode_into};
 use steradian_reference::lobe::brdf::Model;
@@ -192,9 +193,11 @@ pub fn choose_samples(model: &Model, bands: usize, target: f64) -> usize {
     let nodes = Nodes::new(model.feature_angle(), bands, 1);
     for t in [16usize, 23, 30, 45, 90] {
         let at: Vec<Vec<f64>> = (0..t)
+            .into_par_iter()
             .map(|k| project(model, &nodes, theta(k, t)).0)
             .collect();
         let worst = (0..t - 1)
+            .into_par_iter()
             .map(|k| {
                 let mid = project(model, &nodes, 0.5 * (theta(k, t) + theta(k + 1, t))).0;
                 let err: f64 = mid
@@ -205,7 +208,7 @@ pub fn choose_samples(model: &Model, bands: usize, target: f64) -> usize {
                 let norm: f64 = mid.iter().map(|m| m * m).sum();
                 (err / norm.max(1e-300)).sqrt()
             })
-            .fold(0.0, f64::max);
+            .reduce(|| 0.0, f64::max);
         if worst <= target / 10.0 {
             return t;
         }
@@ -217,9 +220,15 @@ pub fn choose_samples(model: &Model, bands: usize, target: f64) -> usize {
 pub fn table(model: &Model, bands: usize, samples: usize) -> Vec<u8> {
     let nodes = Nodes::new(model.feature_angle(), bands, 1);
     let ns = stored(bands);
+    let views: Vec<(Vec<f64>, Vec<f64>)> = (0..samples)
+        .into_par_iter()
+        .map(|k| {
+            let (f, fp, _, _) = project(model, &nodes, theta(k, samples));
+            (f, fp)
+        })
+        .collect();
     let mut values = Vec::with_capacity(samples * 2 * ns);
-    for k in 0..samples {
-        let (f, fp, _, _) = project(model, &nodes, theta(k, samples));
+    for (f, fp) in &views {
         values.extend(f.iter().map(|&v| v as f32));
         values.extend(fp.iter().map(|&v| v as f32));
     }

@@ -279,6 +279,14 @@ fn hvl_settings(scene: &Scene) -> (Vec<Setting<'_>>, Vec<Setting<'_>>) {
             },
             false,
         ),
+        mk(
+            format!(
+                "{} HVLs, diffuse receivers only (no glossy tables)",
+                6 * d.side * d.side * scene.lights.len()
+            ),
+            hvl::Options { glossy: false, ..d },
+            false,
+        ),
         Setting {
             label: "direct light only (lobes)".into(),
             render: Box::new(move || {

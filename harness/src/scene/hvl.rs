@@ -13,10 +13,12 @@
 //!
 //! **Emission and reception** (eq. 19–22, `steradian_core::sh::hvl::contribution`): an HVL
 //! reflects its surface's *diffuse* albedo (Lambertian emission, exact in one band); a
-//! receiver's diffuse albedo times the 5-band Lambert table. Both are linear, so the
-//! scalar contribution of a unit HVL is computed once per pair and scaled in RGB by the
-//! light's radiance and the two albedos. Glossy parts are not carried by the indirect
-//! term (a BRDF table per material would be: not built here). The paper does not test
+//! receiver's diffuse albedo times the 5-band Lambert table, and each of its glossy parts
+//! times a BRDF SH table generated for it ([`Glossy`]). All are linear, so the scalar
+//! contribution of a unit HVL is computed once per pair and part and scaled in RGB by the
+//! light's radiance, the HVL's albedo and the part's scale. HVLs do not emit their glossy
+//! parts (the emission would need each HVL's `F′` at its light direction, and one more
+//! basis evaluation per pair and part). The paper does not test
 //! visibility between an HVL and the receiver; here a shadow ray per pair does by default
 //! ([`Options::visibility`]), which the harness measures on the `room` scene.
 
@@ -28,6 +30,7 @@ use steradian_core::lobe::sum::ProductCounts;
 use steradian_core::sh::{brdf, hvl as core_hvl};
 
 use super::image::Image;
+use super::material::Material;
 use super::{Kind, Ray, Rgb, Scene, ShadingPoint, lobes, path, render_centres};
 
 /// Settings of the `hvl` method.
@@ -39,6 +42,9 @@ pub struct Options {
     pub direct: lobes::Options,
     /// Test each HVL–receiver pair with a shadow ray (the paper does not: `false`).
     pub visibility: bool,
+    /// Carry the receivers' glossy parts (Phong, Lafortune) through BRDF SH tables built
+    /// for the scene's materials ([`Glossy`]); `false` keeps only the diffuse part.
+    pub glossy: bool,
 }
 
 impl Default for Options {
@@ -47,6 +53,7 @@ impl Default for Options {
             side: 8,
             direct: lobes::Options::default(),
             visibility: true,
+            glossy: true,
         }
     }
 }
@@ -146,6 +153,8 @@ pub struct Scratch {
     coeffs: Vec<f32>,
     zonal: Vec<f32>,
     sh: Vec<f32>,
+    /// `F` of each glossy part of the current receiver, `n²` each.
+    glossy: Vec<Vec<f32>>,
 }
 
 impl Default for Scratch {
@@ -155,32 +164,164 @@ impl Default for Scratch {
             coeffs: vec![0.0; n * n],
             zonal: vec![0.0; n],
             sh: vec![0.0; n * n],
+            glossy: Vec::new(),
         }
     }
 }
 
-/// The indirect radiance at a shading point from the placed HVLs. The receiver is its
-/// diffuse part, whose Lambert coefficients are zonal in its view frame (the table's
-/// `m ≠ 0` entries are below `1e-6` of `F_0^0`, asserted in core), so each HVL goes through
-/// [`core_hvl::contribution_zonal`] with the `m = 0` entries: `n` basis values per HVL
-/// instead of `n²`.
+/// Truncation target of the receivers' glossy tables: relative L2 of `F` at `θₒ = 45°`,
+/// the built-in tables' (`generate::brdf_sh::TARGET`).
+pub const GLOSSY_TARGET: f64 = crate::generate::brdf_sh::TARGET;
+
+/// One glossy part of a material as a receiver: its BRDF SH table (unit scale) and the RGB
+/// that scales it.
+pub struct GlossyPart {
+    /// The table's file bytes (`steradian_core::sh::brdf` format).
+    pub table: Vec<u8>,
+    /// Its band count.
+    pub bands: usize,
+    /// Its view samples.
+    pub samples: usize,
+    /// Phong's `specular`, a Lafortune lobe's `ρ`.
+    pub scale: Rgb,
+}
+
+/// The glossy parts of every material of a scene, by material index: a modified Phong
+/// material's specular term (`k_s = 1`, its exponent) and each lobe of a Lafortune
+/// material (`ρ = 1`), each projected by `generate::brdf_sh` with the fewest bands and
+/// views that meet [`GLOSSY_TARGET`] (tables shared between identical parts). Lambert
+/// materials have none; GGX is not carried by this method.
+pub struct Glossy {
+    /// Per material, its parts.
+    pub parts: Vec<Vec<GlossyPart>>,
+}
+
+impl Glossy {
+    /// No glossy part anywhere (the diffuse-only receiver).
+    pub fn none(scene: &Scene) -> Glossy {
+        Glossy {
+            parts: scene.materials.iter().map(|_| Vec::new()).collect(),
+        }
+    }
+
+    /// The tables of `scene`'s materials (module docs of [`Glossy`]).
+    pub fn build(scene: &Scene) -> Glossy {
+        use crate::generate::brdf_sh as gen_sh;
+        use steradian_reference::lobe::brdf::Model;
+        // One table per distinct part and process: the plan's probes and the render use the
+        // same tables, and a generation costs seconds.
+        type Cache = Vec<([u64; 4], usize, usize, Vec<u8>)>;
+        static BUILT: std::sync::Mutex<Cache> = std::sync::Mutex::new(Vec::new());
+        let table_of = |key: [u64; 4], model: Model| {
+            let mut built = BUILT.lock().unwrap_or_else(|e| e.into_inner());
+            if let Some((_, n, t, bytes)) = built.iter().find(|b| b.0 == key) {
+                return (bytes.clone(), *n, *t);
+            }
+            let n = gen_sh::choose_bands(&model, GLOSSY_TARGET);
+            let t = gen_sh::choose_samples(&model, n, GLOSSY_TARGET);
+            let bytes = gen_sh::table(&model, n, t);
+            built.push((key, n, t, bytes.clone()));
+            (bytes, n, t)
+        };
+        let parts = scene
+            .materials
+            .iter()
+            .map(|m| match m {
+                Material::Phong {
+                    specular, exponent, ..
+                } => {
+                    let model = Model::Phong {
+                        kd: 0.0,
+                        ks: 1.0,
+                        e: *exponent,
+                    };
+                    let (table, bands, samples) = table_of([0, exponent.to_bits(), 0, 0], model);
+                    vec![GlossyPart {
+                        table,
+                        bands,
+                        samples,
+                        scale: *specular,
+                    }]
+                }
+                Material::Lafortune { lobes, .. } => lobes
+                    .iter()
+                    .map(|l| {
+                        let model = Model::Lafortune {
+                            lobes: [[l.c, l.c, l.cz, l.exponent, 1.0], [0.0; 5]],
+                        };
+                        let key = [1, l.c.to_bits(), l.cz.to_bits(), l.exponent.to_bits()];
+                        let (table, bands, samples) = table_of(key, model);
+                        GlossyPart {
+                            table,
+                            bands,
+                            samples,
+                            scale: l.rho,
+                        }
+                    })
+                    .collect(),
+                Material::Lambert { .. } | Material::Ggx { .. } => Vec::new(),
+            })
+            .collect();
+        Glossy { parts }
+    }
+
+    /// The parts' tables read once (validated), for [`indirect`]: per material, each part's
+    /// table and RGB scale. A table that fails validation is left out (the tables come from
+    /// the generator, so none does).
+    pub fn views(&self) -> GlossyViews<'_> {
+        GlossyViews {
+            parts: self
+                .parts
+                .iter()
+                .map(|ps| {
+                    ps.iter()
+                        .filter_map(|p| Some((brdf::BrdfSh::from_bytes(&p.table).ok()?, p.scale)))
+                        .collect()
+                })
+                .collect(),
+        }
+    }
+}
+
+/// [`Glossy`]'s tables, read: per material, each part's table and RGB scale.
+pub struct GlossyViews<'a> {
+    /// Per material, its parts.
+    pub parts: Vec<Vec<(brdf::BrdfSh<'a>, Rgb)>>,
+}
+
+/// The indirect radiance at a shading point from the placed HVLs.
+///
+/// The receiver's diffuse part has Lambert coefficients that are zonal in its view frame
+/// (the table's `m ≠ 0` entries are below `1e-6` of `F_0^0`, asserted in core), so each HVL
+/// goes through [`core_hvl::contribution_zonal`] with the `m = 0` entries: `n` basis values
+/// per HVL instead of `n²`. Each glossy part of `glossy` (its `F` looked up at the view's
+/// `θₒ`) goes through the full [`core_hvl::contribution`]. One HVL's share is clamped at 0
+/// per part (an HVL sends no negative light; the truncated SH can ring below 0), and its
+/// shadow ray is cast once for all parts.
 pub fn indirect(
     scene: &Scene,
     p: &ShadingPoint,
     hvls: &[Placed],
     visibility: bool,
+    glossy: &GlossyViews<'_>,
     scratch: &mut Scratch,
 ) -> Rgb {
     let table = brdf::lambert();
     let albedo = scene.materials[p.material].diffuse();
-    if albedo.iter().all(|&a| a == 0.0) {
-        return [0.0; 3];
-    }
+    let parts = glossy
+        .parts
+        .get(p.material)
+        .map_or(&[][..], |v| v.as_slice());
     let Ok(frame) = brdf::view_frame(p.n.as_vec3(), p.wo.as_vec3()) else {
         return [0.0; 3];
     };
     let theta = frame.to_local(p.wo.as_vec3()).z.clamp(-1.0, 1.0).acos();
-    let Scratch { coeffs, zonal, sh } = scratch;
+    let Scratch {
+        coeffs,
+        zonal,
+        sh,
+        glossy: gcoeffs,
+    } = scratch;
     let n = table.bands();
     if table
         .lookup_into(brdf::Part::WithCosine, theta, n, coeffs)
@@ -191,6 +332,22 @@ pub fn indirect(
     for (l, z) in zonal.iter_mut().enumerate().take(n) {
         *z = coeffs[l * l + l];
     }
+    // Each glossy part's `F` in the view frame (a part whose table cannot be read or looked
+    // up is left out: the tables are built by `Glossy::build`, so this does not happen).
+    gcoeffs.resize_with(parts.len(), Vec::new);
+    let mut live = [false; super::material::MAX_LOBES];
+    for (((t, _), f), on) in parts.iter().zip(gcoeffs.iter_mut()).zip(live.iter_mut()) {
+        let nb = t.bands();
+        f.resize(nb * nb, 0.0);
+        if sh.len() < f.len() {
+            sh.resize(f.len(), 0.0);
+        }
+        *on = t.lookup_into(brdf::Part::WithCosine, theta, nb, f).is_ok();
+    }
+    let diffuse = albedo.iter().any(|&a| a != 0.0);
+    if !diffuse && !live.iter().any(|&on| on) {
+        return [0.0; 3];
+    }
     let rx = core_hvl::ZonalReceiver {
         point: p.x.as_vec3(),
         frame,
@@ -199,11 +356,38 @@ pub fn indirect(
     let emission = core_hvl::lambert_emission(1.0);
     let origin = path::offset(p.x, p.n);
     let mut acc = [0.0f64; 3];
+    let mut gacc = [[0.0f64; 3]; super::material::MAX_LOBES];
+    let mut shares = [0.0f64; super::material::MAX_LOBES];
     for h in hvls {
-        let c =
+        let c = if diffuse {
             core_hvl::contribution_zonal(&h.hvl, &emission, &rx, core_hvl::Horizon::Smoothstep, sh)
-                .unwrap_or(0.0) as f64;
-        if c <= 0.0 {
+                .unwrap_or(0.0)
+                .max(0.0) as f64
+        } else {
+            0.0
+        };
+        let mut any = c > 0.0;
+        for ((f, on), share) in gcoeffs.iter().zip(&live).zip(shares.iter_mut()) {
+            *share = 0.0;
+            if *on {
+                let grx = core_hvl::Receiver {
+                    point: p.x.as_vec3(),
+                    frame,
+                    coeffs: f,
+                };
+                *share = core_hvl::contribution(
+                    &h.hvl,
+                    &emission,
+                    &grx,
+                    core_hvl::Horizon::Smoothstep,
+                    sh,
+                )
+                .unwrap_or(0.0)
+                .max(0.0) as f64;
+                any |= *share > 0.0;
+            }
+        }
+        if !any {
             continue;
         }
         if visibility {
@@ -220,8 +404,19 @@ pub fn indirect(
         for (a, w) in acc.iter_mut().zip(h.weight) {
             *a += c * w;
         }
+        for (g, share) in gacc.iter_mut().zip(&shares).take(parts.len()) {
+            for (a, w) in g.iter_mut().zip(h.weight) {
+                *a += share * w;
+            }
+        }
     }
-    [acc[0] * albedo[0], acc[1] * albedo[1], acc[2] * albedo[2]]
+    let mut out: Rgb = core::array::from_fn(|k| acc[k] * albedo[k]);
+    for ((_, scale), g) in parts.iter().zip(&gacc) {
+        for k in 0..3 {
+            out[k] += g[k] * scale[k];
+        }
+    }
+    out
 }
 
 /// The reflective-shadow-map face sides a plan tries, smallest first ([`choose_side`]):
@@ -253,6 +448,12 @@ pub fn choose_side(scene: &Scene, o: &Options, target: f64) -> SideChoice {
         .map(|p| lobes::shade(scene, p, &o.direct, &mut counts))
         .collect();
     let mut scratch = Scratch::default();
+    let glossy = if o.glossy {
+        Glossy::build(scene)
+    } else {
+        Glossy::none(scene)
+    };
+    let glossy = glossy.views();
     let images: Vec<Vec<Rgb>> = SIDE_CANDIDATES
         .iter()
         .map(|&side| {
@@ -261,7 +462,7 @@ pub fn choose_side(scene: &Scene, o: &Options, target: f64) -> SideChoice {
                 .iter()
                 .zip(&direct)
                 .map(|(p, d)| {
-                    let i = indirect(scene, p, &hvls, o.visibility, &mut scratch);
+                    let i = indirect(scene, p, &hvls, o.visibility, &glossy, &mut scratch);
                     [d[0] + i[0], d[1] + i[1], d[2] + i[2]]
                 })
                 .collect()
@@ -276,10 +477,16 @@ pub fn choose_side(scene: &Scene, o: &Options, target: f64) -> SideChoice {
 /// per pixel ([`super::render_centres`]); returns the image and the HVL count.
 pub fn render(scene: &Scene, o: &Options, bar: &ProgressBar) -> (Image, usize) {
     let hvls = place(scene, o.side);
+    let glossy = if o.glossy {
+        Glossy::build(scene)
+    } else {
+        Glossy::none(scene)
+    };
+    let glossy = glossy.views();
     let new_state = || (ProductCounts::default(), Scratch::default());
     let (img, _) = render_centres(scene, bar, new_state, |(counts, scratch), p| {
         let d = lobes::shade(scene, p, &o.direct, counts);
-        let ind = indirect(scene, p, &hvls, o.visibility, scratch);
+        let ind = indirect(scene, p, &hvls, o.visibility, &glossy, scratch);
         [d[0] + ind[0], d[1] + ind[1], d[2] + ind[2]]
     });
     (img, hvls.len())
