@@ -704,16 +704,25 @@ fn rsl_plans_k_from_the_target_error() {
     let c = rsl::choose_k(&small.scene, &o, target).unwrap();
     eprintln!("{c:?}");
     assert_choice(&c.estimates, c.k, target);
+    // The visibility-map side by the same rule (the README's figure: 16 at 48 columns).
+    assert_eq!(c.side_estimates.last(), Some(&(64, 0.0)));
+    assert_choice(&c.side_estimates, c.vis_side, target);
+    assert_eq!(c.vis_side, 16);
     let loose = rsl::choose_k(&small.scene, &o, 0.05).unwrap();
     assert!(loose.k < c.k, "{loose:?}");
+    assert!(loose.vis_side <= c.vis_side, "{loose:?}");
     let img = rsl::render(
         &small.scene,
-        &rsl::Options { k: c.k, ..o },
+        &rsl::Options {
+            k: c.k,
+            vis_side: c.vis_side,
+            ..o
+        },
         &ProgressBar::hidden(),
     )
     .unwrap();
     let m = small.errors(&img);
-    eprintln!("rsl at K = {}: {m:?}", c.k);
+    eprintln!("rsl at K = {}, side {}: {m:?}", c.k, c.vis_side);
     assert!(
         m.mean_abs_over_max < target + 4.0 * m.reference_noise_over_max,
         "{m:?}"

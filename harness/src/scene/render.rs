@@ -190,6 +190,7 @@ pub fn plan(scene: &Scene, o: &Options) -> Result<Plan, String> {
             r.vis_depth = super::rsl::coverage_depth_for(o.target_error);
             let choice = super::rsl::choose_k(scene, &r, o.target_error)?;
             r.k = choice.k;
+            r.vis_side = choice.vis_side;
             let est = estimates_text("K = ", &choice.estimates);
             p.push(PlanItem {
                 item: "rsls".into(),
@@ -219,7 +220,17 @@ pub fn plan(scene: &Scene, o: &Options) -> Result<Plan, String> {
                     "{0}×{0} coverage → moment tables per point",
                     r.vis_side
                 )),
-                reason: "caps of the other spheres and the planes the point is not on".into(),
+                reason: format!(
+                    "caps of the other spheres and the planes the point is not on; {} is the \
+                     smallest side of {:?} whose maps keep {} probe pixels within {} of the \
+                     target {} of the largest side's, with the chosen K ({})",
+                    r.vis_side,
+                    super::rsl::VIS_SIDE_CANDIDATES,
+                    super::PROBES.0 * super::PROBES.1,
+                    super::PLAN_SHARE,
+                    o.target_error,
+                    estimates_text("side ", &choice.side_estimates)
+                ),
             });
             p.push(PlanItem {
                 item: "kernel".into(),

@@ -159,6 +159,9 @@ pub fn build_many(scene: &Scene, o: &Options, ks: &[usize]) -> Result<BuiltMany,
 /// The `K` a plan tries, smallest first ([`choose_k`]).
 pub const K_CANDIDATES: [usize; 5] = [10, 30, 100, 300, 1000];
 
+/// The visibility-map sides a plan tries, smallest first ([`choose_k`]).
+pub const VIS_SIDE_CANDIDATES: [usize; 4] = [8, 16, 32, 64];
+
 /// What [`choose_k`] chose and what it measured.
 #[derive(Clone, Debug)]
 pub struct KChoice {
@@ -167,6 +170,10 @@ pub struct KChoice {
     /// `(K, estimate)`: the probes' mean |difference| from the largest candidate over its
     /// largest value.
     pub estimates: Vec<(usize, f64)>,
+    /// The chosen side of each point's visibility map.
+    pub vis_side: usize,
+    /// `(side, estimate)` with the chosen `K`, as for `estimates`.
+    pub side_estimates: Vec<(usize, f64)>,
 }
 
 /// The smallest `K` of [`K_CANDIDATES`] whose light decomposition alone keeps the shaded
@@ -177,6 +184,11 @@ pub struct KChoice {
 /// decomposition's alone (the error that dominates `rsl` on the built-in scenes; the rest
 /// of the target is left to visibility and the SATs). The largest candidate if none is
 /// within.
+///
+/// Then, with the chosen `K`'s lights, the smallest visibility-map side of
+/// [`VIS_SIDE_CANDIDATES`] by the same rule against the largest side (the probes' maps
+/// built at each side, at `o.vis_depth`): the cost of a point's map grows with its area
+/// while its error stops falling once the texels resolve the occluders' caps.
 pub fn choose_k(scene: &Scene, o: &Options, target: f64) -> Result<KChoice, String> {
     let texels = 6 * o.face * o.face;
     let ks: Vec<usize> = K_CANDIDATES
@@ -200,21 +212,49 @@ pub fn choose_k(scene: &Scene, o: &Options, target: f64) -> Result<KChoice, Stri
         lambert,
         specular,
     };
-    let shaded: Vec<(usize, Vec<Rgb>)> = by_k
-        .into_iter()
-        .map(|(k, lights)| {
-            b.lights = lights;
-            let img = probes
+    let (mut order, mut images, mut lights_of) = (Vec::new(), Vec::new(), Vec::new());
+    for (k, lights) in by_k {
+        b.lights = lights;
+        images.push(
+            probes
                 .iter()
                 .map(|(p, (frame, m))| shade_with(scene, &b, p, frame, m))
-                .collect();
-            (k, img)
-        })
-        .collect();
-    let (order, images): (Vec<usize>, Vec<Vec<Rgb>>) = shaded.into_iter().unzip();
+                .collect::<Vec<Rgb>>(),
+        );
+        order.push(k);
+        lights_of.push(std::mem::take(&mut b.lights));
+    }
     let (k, estimates) =
         super::plan_choice(&order, &images, target).ok_or("no candidate K fits the cube map")?;
-    Ok(KChoice { k, estimates })
+    // The visibility-map side with the chosen K's lights.
+    let pos = order.iter().position(|&c| c == k).unwrap_or(0);
+    b.lights = lights_of.swap_remove(pos);
+    let points = super::probe_points(scene);
+    let side_images: Vec<Vec<Rgb>> = VIS_SIDE_CANDIDATES
+        .iter()
+        .map(|&side| {
+            let os = Options {
+                vis_side: side,
+                ..*o
+            };
+            let mut cov = vec![0.0f32; side * side];
+            points
+                .iter()
+                .map(|p| match point_moments(scene, &os, p, &mut cov) {
+                    Some((frame, m)) => shade_with(scene, &b, p, &frame, &m),
+                    None => [0.0; 3],
+                })
+                .collect()
+        })
+        .collect();
+    let (vis_side, side_estimates) = super::plan_choice(&VIS_SIDE_CANDIDATES, &side_images, target)
+        .ok_or("no visibility-map side")?;
+    Ok(KChoice {
+        k,
+        estimates,
+        vis_side,
+        side_estimates,
+    })
 }
 
 /// The visibility moment tables of a surface point (module docs), `None` where the point
