@@ -110,14 +110,16 @@ pub fn project(model: &Model, nodes: &Nodes, theta_o: f64) -> (Vec<f64>, Vec<f64
     let (mut f, mut fp) = (vec![0.0; ns], vec![0.0; ns]);
     let (mut nf, mut nfp) = (0.0, 0.0);
     let (mut g, mut gp) = (vec![0.0; n], vec![0.0; n]);
+    // The azimuths' (sin, cos), the same at every `θ` node.
+    let phis: Vec<(f64, f64)> = (0..nphi)
+        .map(|j| ((j as f64 + 0.5) * dphi).sin_cos())
+        .collect();
     for (k, &(t, wt)) in nodes.theta.iter().enumerate() {
         let (s, c) = t.sin_cos();
         g.fill(0.0);
         gp.fill(0.0);
         let (mut sq, mut sqp) = (0.0, 0.0);
-        for j in 0..nphi {
-            let ph = (j as f64 + 0.5) * dphi;
-            let (sp, cp) = ph.sin_cos();
+        for &(sp, cp) in &phis {
             let rho = model.rho([s * cp, s * sp, c], wo);
             if rho == 0.0 {
                 continue;

@@ -81,18 +81,27 @@ impl Model {
         if wi[2] <= 0.0 || wo[2] <= 0.0 {
             return 0.0;
         }
-        let h = unit([wi[0] + wo[0], wi[1] + wo[1], wi[2] + wo[2]]);
+        // The half vector only where a model reads it (the quadratures call this millions
+        // of times).
+        let h = || unit([wi[0] + wo[0], wi[1] + wo[1], wi[2] + wo[2]]);
         match *self {
             Model::Lambert { a } => a / PI,
             Model::Phong { kd, ks, e } => {
                 let r = [-wo[0], -wo[1], wo[2]];
                 let c = dot(r, wi).max(0.0);
-                kd / PI + ks * (e + 2.0) / (2.0 * PI) * libm::pow(c, e)
+                // `pow(0, e) = 0` for `e > 0`: skipped, the same value.
+                let p = if c > 0.0 || e == 0.0 {
+                    libm::pow(c, e)
+                } else {
+                    0.0
+                };
+                kd / PI + ks * (e + 2.0) / (2.0 * PI) * p
             }
             Model::BlinnPhong { kd, ks, e } => {
-                kd / PI + ks * (e + 8.0) / (8.0 * PI) * libm::pow(h[2], e)
+                kd / PI + ks * (e + 8.0) / (8.0 * PI) * libm::pow(h()[2], e)
             }
             Model::Ward { rd, rs, ax, ay } => {
+                let h = h();
                 let tan2 = (1.0 - h[2] * h[2]) / (h[2] * h[2]);
                 let sin2 = h[0] * h[0] + h[1] * h[1];
                 let (c2, s2) = if sin2 > 0.0 {
@@ -111,6 +120,7 @@ impl Model {
                 })
                 .sum(),
             Model::Ggx { kd, f0, alpha } => {
+                let h = h();
                 let a2 = alpha * alpha;
                 let ch = h[2];
                 let d = a2 / (PI * (ch * ch * (a2 - 1.0) + 1.0).powi(2));
