@@ -98,7 +98,7 @@ enum Command {
         /// kernel otherwise; the other methods are scalar).
         #[arg(long)]
         scalar: bool,
-        /// Shade on the wgpu backend (rsl; an error without an adapter).
+        /// Shade on the wgpu backend (rsl; hvl its diffuse indirect light; an error without an adapter).
         #[arg(long, conflicts_with = "scalar")]
         gpu: bool,
     },

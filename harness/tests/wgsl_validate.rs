@@ -134,6 +134,19 @@ fn every_custom_kernel_validates_with_the_documented_interface() {
     }
 }
 
+/// The kernels that are neither registered nor custom (they serve the harness's own paths)
+/// validate too, without an adapter.
+#[test]
+fn unlisted_kernels_validate_with_the_documented_interface() {
+    for (name, src) in [
+        ("sh-hvl", wgsl::SH_HVL),
+        ("sh-hvl-exact", wgsl::SH_HVL_EXACT),
+        ("sh-hvl-sum", wgsl::SH_HVL_SUM),
+    ] {
+        check_interface(name, src, Some("f32"));
+    }
+}
+
 #[test]
 fn all_lists_every_kernel_once() {
     let mut names: Vec<_> = wgsl::ALL.iter().map(|(n, _)| *n).collect();

@@ -326,6 +326,24 @@ pub const SH_HVL_EXACT: &str = concat!(
 /// them and asserts `2e-4` for those).
 pub const SH_HVL_TOL: f32 = 2.0e-5;
 
+/// The diffuse light a set of Lambertian HVLs sends to receivers, one receiver per row
+/// (`sh::hvl::contribution_zonal` with the smoothstep horizon and `lambert_emission(1)`,
+/// each contribution clamped at 0, summed with each HVL's RGB weight), with an optional
+/// shadow ray per HVL–receiver pair against sphere and plane occluders: the `hvl` scene
+/// method's wgpu path. Input columns `[x, y, z, n (3), origin (3), F_0 … F_{n−1}]` (the
+/// receiver, its normal, the shadow rays' origin, its zonal `F`), output
+/// three columns; binding 3 holds the HVLs and occluders (layout in `sh_hvl_sum.wgsl`),
+/// `n ≤ 16` bands. Not a registered kernel (no `eval` contract); the harness test
+/// `tests/sh_gpu.rs` builds it. Tolerance: [`SH_HVL_SUM_TOL`].
+pub const SH_HVL_SUM: &str = concat!(
+    include_str!("batch.wgsl"),
+    include_str!("../sh/sh_hvl_sum.wgsl")
+);
+/// Difference allowed between [`SH_HVL_SUM`] and the CPU sum per receiver, relative to the
+/// largest RGB component of that receiver's sum, where no shadow ray changes its answer
+/// between `f32` and `f64` (each term within [`SH_HVL_TOL`] of its largest).
+pub const SH_HVL_SUM_TOL: f32 = 1.0e-4;
+
 /// The irradiance of one radiance vector at many normals (`sh::irradiance::irradiance`) in
 /// `f32`, for `bands ≤ 32`: the basis of [`SH_EVAL`] at the normal, dotted band by band
 /// with the radiance and weighted by the clamped-cosine factors. Input columns `[x, y, z]`,

@@ -246,7 +246,10 @@ fn lobes_settings(scene: &Scene) -> (Vec<Setting<'_>>, Vec<Setting<'_>>) {
     (curve, variants)
 }
 
-fn hvl_settings(scene: &Scene) -> (Vec<Setting<'_>>, Vec<Setting<'_>>) {
+fn hvl_settings<'a>(
+    scene: &'a Scene,
+    gpu: Option<&'a std::sync::Mutex<crate::backend::gpu::Gpu>>,
+) -> (Vec<Setting<'a>>, Vec<Setting<'a>>) {
     let d = planned(scene, render::Method::Hvl).map_or_else(hvl::Options::default, |p| p.hvl);
     let mk = move |label: String, o: hvl::Options, default: bool| Setting {
         label,
@@ -267,7 +270,7 @@ fn hvl_settings(scene: &Scene) -> (Vec<Setting<'_>>, Vec<Setting<'_>>) {
         .collect();
     let px = scene.camera.pixels() as f64;
     let direct = d.direct;
-    let variants = vec![
+    let mut variants = vec![
         mk(
             format!(
                 "{} HVLs, no HVL visibility (the paper)",
@@ -287,17 +290,38 @@ fn hvl_settings(scene: &Scene) -> (Vec<Setting<'_>>, Vec<Setting<'_>>) {
             hvl::Options { glossy: false, ..d },
             false,
         ),
-        Setting {
-            label: "direct light only (lobes)".into(),
+    ];
+    if let Some(gpu) = gpu {
+        variants.push(Setting {
+            label: format!(
+                "{} HVLs, wgpu (diffuse indirect on the adapter)",
+                6 * d.side * d.side * scene.lights.len()
+            ),
             render: Box::new(move || {
-                let (img, c) = lobes::render(scene, &direct, &ProgressBar::hidden());
-                (img, Some(c.computed as f64 / px))
+                let blank =
+                    || Image::new(scene.camera.width as usize, scene.camera.height as usize);
+                let img = gpu
+                    .lock()
+                    .map_err(|_| "adapter lock poisoned".to_string())
+                    .and_then(|mut g| hvl::render_gpu(scene, &d, &mut g, &ProgressBar::hidden()))
+                    .map_or_else(|_| blank(), |(img, _)| img);
+                (img, None)
             }),
             default: false,
             build_seconds: None,
-            per_core: None,
-        },
-    ];
+            per_core: Some("wgpu"),
+        });
+    }
+    variants.extend([Setting {
+        label: "direct light only (lobes)".into(),
+        render: Box::new(move || {
+            let (img, c) = lobes::render(scene, &direct, &ProgressBar::hidden());
+            (img, Some(c.computed as f64 / px))
+        }),
+        default: false,
+        build_seconds: None,
+        per_core: None,
+    }]);
     (curve, variants)
 }
 
@@ -402,7 +426,7 @@ fn measure_scene(
     }
     bar.inc(1);
     let (curve_settings, variant_settings) = match method {
-        "hvl" => hvl_settings(&scene),
+        "hvl" => hvl_settings(&scene, gpu),
         "rsl" => rsl_settings(&scene, gpu),
         _ => lobes_settings(&scene),
     };

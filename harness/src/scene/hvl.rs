@@ -67,6 +67,9 @@ pub struct Placed {
     pub hvl: core_hvl::Hvl,
     /// `Φ·albedo` in RGB: what multiplies the unit contribution.
     pub weight: Rgb,
+    /// The scene object the HVL lies on (a shadow ray toward it, from a receiver it faces,
+    /// cannot meet that object before its end: the object is convex or a plane).
+    pub object: usize,
 }
 
 /// The HVLs of every spherical light.
@@ -118,7 +121,11 @@ pub fn place(scene: &Scene, side: usize) -> Vec<Placed> {
                     for c in 0..3 {
                         w[c] = intensity[c] * omega * albedo[c];
                     }
-                    out.push(Placed { hvl: h, weight: w });
+                    out.push(Placed {
+                        hvl: h,
+                        weight: w,
+                        object: hit.object,
+                    });
                 }
             }
         }
@@ -308,8 +315,26 @@ pub fn indirect(
     glossy: &GlossyViews<'_>,
     scratch: &mut Scratch,
 ) -> Rgb {
+    indirect_parts(scene, p, hvls, visibility, glossy, true, scratch)
+}
+
+/// [`indirect`] with the diffuse part left out where `diffuse` is false (the wgpu path
+/// sums it on the GPU and only the glossy parts here).
+fn indirect_parts(
+    scene: &Scene,
+    p: &ShadingPoint,
+    hvls: &[Placed],
+    visibility: bool,
+    glossy: &GlossyViews<'_>,
+    diffuse: bool,
+    scratch: &mut Scratch,
+) -> Rgb {
     let table = brdf::lambert();
-    let albedo = scene.materials[p.material].diffuse();
+    let albedo = if diffuse {
+        scene.materials[p.material].diffuse()
+    } else {
+        [0.0; 3]
+    };
     let parts = glossy
         .parts
         .get(p.material)
@@ -419,6 +444,137 @@ pub fn indirect(
         }
     }
     out
+}
+
+/// The shadow rays of the wgpu path stop at `d·(1 − ε)` before the HVL, as [`indirect`]'s
+/// do.
+const GPU_SUM_EPS: f32 = 1e-4;
+
+/// Receivers per dispatch of the wgpu path.
+pub const GPU_BATCH: usize = 4096;
+
+/// The table of `steradian_core::wgsl::SH_HVL_SUM`: the HVLs (Lambertian emitters, each with
+/// the object it lies on, which its shadow rays skip) and every object of the scene as an
+/// occluder.
+fn gpu_sum_table(scene: &Scene, hvls: &[Placed], bands: usize, visibility: bool) -> Vec<f32> {
+    let mut t = vec![
+        hvls.len() as f32,
+        scene.objects.len() as f32,
+        bands as f32,
+        if visibility { 1.0 } else { 0.0 },
+        GPU_SUM_EPS,
+    ];
+    for h in hvls {
+        let (p, n) = (h.hvl.position(), h.hvl.frame().normal());
+        t.extend([p.x, p.y, p.z, n.x, n.y, n.z, h.hvl.radius(), h.hvl.power()]);
+        t.extend(h.weight.map(|w| w as f32));
+        t.push(h.object as f32);
+    }
+    for obj in &scene.objects {
+        t.extend(match obj.shape {
+            super::Shape::Sphere { center: c, radius } => {
+                [0.0, c.x, c.y, c.z, radius, 0.0, 0.0].map(|v| v as f32)
+            }
+            super::Shape::Plane {
+                point: a,
+                normal: n,
+            } => [1.0, a.x, a.y, a.z, n.x, n.y, n.z].map(|v| v as f32),
+        });
+    }
+    t
+}
+
+/// [`render`] with the diffuse indirect light on the wgpu backend: the direct light and the
+/// receivers' glossy parts on the CPU as [`render`] computes them, and each receiver's
+/// diffuse sum over the HVLs by `steradian_core::wgsl::SH_HVL_SUM` ([`GPU_BATCH`] receivers
+/// per dispatch, the shadow rays against the scene's spheres and planes in `f32` from the
+/// CPU path's origin, skipping the object the HVL lies on: in `f32` a ray grazing a plane
+/// toward an HVL on it meets the plane before its end),
+/// times the receiver's diffuse
+/// albedo. Each receiver's sum is within `steradian_core::wgsl::SH_HVL_SUM_TOL` of the
+/// CPU's wherever no shadow ray flips between `f32` and `f64` (harness test
+/// `tests/sh_gpu.rs`).
+///
+/// Errors: the kernel's.
+pub fn render_gpu(
+    scene: &Scene,
+    o: &Options,
+    gpu: &mut crate::backend::gpu::Gpu,
+    bar: &ProgressBar,
+) -> Result<(Image, usize), String> {
+    use crate::backend::gpu::Custom;
+    use crate::kernels::Columns;
+    let glossy = if o.glossy {
+        Glossy::build(scene)
+    } else {
+        Glossy::none(scene)
+    };
+    let views = glossy.views();
+    let hvls = place(scene, o.side);
+    let lambert = brdf::lambert();
+    let nb = lambert.bands();
+    let table = gpu_sum_table(scene, &hvls, nb, o.visibility);
+    let new_state = || (ProductCounts::default(), Scratch::default());
+    let (mut img, _) = render_centres(scene, bar, new_state, |(counts, scratch), p| {
+        let d = lobes::shade(scene, p, &o.direct, counts);
+        let g = indirect_parts(scene, p, &hvls, o.visibility, &views, false, scratch);
+        [d[0] + g[0], d[1] + g[1], d[2] + g[2]]
+    });
+    // The receivers with a diffuse part: pixel, albedo and the kernel's input row.
+    let cam = scene.camera;
+    let (w, h) = (cam.width as usize, cam.height as usize);
+    let mut rows: Vec<(usize, Rgb, Vec<f32>)> = Vec::new();
+    let mut coeffs = vec![0.0f32; nb * nb];
+    for j in 0..h {
+        for i in 0..w {
+            let super::Seen::Surface(p) = scene.see(&cam.centre_ray(i as u32, j as u32)) else {
+                continue;
+            };
+            let albedo = scene.materials[p.material].diffuse();
+            if albedo.iter().all(|&a| a == 0.0) {
+                continue;
+            }
+            let Ok(frame) = brdf::view_frame(p.n.as_vec3(), p.wo.as_vec3()) else {
+                continue;
+            };
+            let theta = frame.to_local(p.wo.as_vec3()).z.clamp(-1.0, 1.0).acos();
+            if lambert
+                .lookup_into(brdf::Part::WithCosine, theta, nb, &mut coeffs)
+                .is_err()
+            {
+                continue;
+            }
+            let origin = path::offset(p.x, p.n);
+            let (x, n) = (p.x.as_vec3(), frame.normal());
+            let mut row = vec![x.x, x.y, x.z, n.x, n.y, n.z];
+            row.extend([origin.x as f32, origin.y as f32, origin.z as f32]);
+            row.extend((0..nb).map(|l| coeffs[l * l + l]));
+            rows.push((j * w + i, albedo, row));
+        }
+    }
+    let arity = 9 + nb;
+    let custom = Custom {
+        label: "hvl-sum",
+        source: steradian_core::wgsl::SH_HVL_SUM,
+        table: Some(&table),
+    };
+    for chunk in rows.chunks(GPU_BATCH) {
+        let mut input = Columns::zeros(arity, chunk.len());
+        for (r, (_, _, row)) in chunk.iter().enumerate() {
+            for (c, v) in row.iter().enumerate() {
+                input.data[c * chunk.len() + r] = *v;
+            }
+        }
+        let mut out = Columns::zeros(3, chunk.len());
+        gpu.run_custom(&custom, &input, &mut out)
+            .map_err(|e| format!("hvl-sum kernel: {e}"))?;
+        for (r, (k, albedo, _)) in chunk.iter().enumerate() {
+            for (c, (px, a)) in img.data[*k].iter_mut().zip(albedo).enumerate() {
+                *px += f64::from(out.data[c * chunk.len() + r]) * a;
+            }
+        }
+    }
+    Ok((img, hvls.len()))
 }
 
 /// The reflective-shadow-map face sides a plan tries, smallest first ([`choose_side`]):

@@ -162,9 +162,9 @@ pub fn plan(scene: &Scene, o: &Options) -> Result<Plan, String> {
     let mut lo = lobes::Options::default();
     let mut r = super::rsl::Options::default();
     let mut hv = super::hvl::Options::default();
-    if o.gpu && o.method != Method::Rsl {
+    if o.gpu && !matches!(o.method, Method::Rsl | Method::Hvl) {
         return Err(format!(
-            "--gpu: only method rsl has a wgpu path (not {})",
+            "--gpu: only methods rsl and hvl have a wgpu path (not {})",
             o.method.name()
         ));
     }
@@ -476,8 +476,18 @@ pub fn run(scene: &Scene, scene_name: &str, o: &Options, plan: &Plan) -> Result<
             )
         }
         Method::Hvl => {
-            let (img, count) = super::hvl::render(scene, &plan.hvl, &b);
-            (img, None, json!({ "hvls": count }))
+            let (img, count) = if o.gpu {
+                let mut gpu = crate::backend::gpu::try_gpu()
+                    .map_err(|e| format!("--gpu: no wgpu adapter: {e}"))?;
+                super::hvl::render_gpu(scene, &plan.hvl, &mut gpu, &b)?
+            } else {
+                super::hvl::render(scene, &plan.hvl, &b)
+            };
+            (
+                img,
+                None,
+                json!({ "hvls": count, "kernel": if o.gpu { "wgpu" } else { "scalar" } }),
+            )
         }
     };
     let seconds = start.elapsed().as_secs_f64();
