@@ -542,7 +542,7 @@ fn fill_any(pt: Point, bands: usize, out: &mut [f32]) {
 
 /// The zonal functions `Y_l^0`, `l < bands`, at `dir` into `out[..bands]`: the `m = 0`
 /// chain of [`eval_into`]'s recurrence alone (`Π_0^0`, `Π_1^0 = √3·z·Π_0^0`, then
-/// [`step`], each times `r^−l`), the same operations on the same point, so each value is
+/// `step`, each times `r^−l`), the same operations on the same point, so each value is
 /// bit-identical to `eval_into`'s at index `l² + l` (tested). What a receiver whose
 /// coefficients are zonal around its normal needs (`sh::hvl::contribution_zonal`): `bands`
 /// values instead of `bands²`.

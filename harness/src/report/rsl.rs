@@ -82,7 +82,7 @@ pub struct EnvResult {
     pub luminance_integral: f64,
     /// Every `K`, in decomposition order (largest first).
     pub rows: Vec<KRow>,
-    /// The partition at [`K_PICTURE`], if it was reached.
+    /// The partition at `K_PICTURE`, if it was reached.
     pub regions: Option<Regions>,
 }
 

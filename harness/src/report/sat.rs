@@ -99,7 +99,7 @@ fn options(g: &Grid) -> Result<Vec<Box<dyn Storage>>, Box<dyn Error>> {
     ])
 }
 
-/// Median times of the speed measurements at [`SIDE`]².
+/// Median times of the speed measurements at `SIDE`².
 #[derive(Clone, Debug)]
 pub struct SatTimes {
     /// Build, ours (i64).

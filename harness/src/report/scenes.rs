@@ -8,7 +8,7 @@
 //! whose reference is the noisiest per sample), direct light for `lobes` and `cluster` and
 //! one bounce for `room`; the path tracer's curve is the same tracer with other seeds at
 //! [`PATH_SPP`] samples. The default point of `lobes` and `hvl` is what `steradian render`
-//! plans at the default target error ([`planned`]). The `lobes` method's curve is its
+//! plans at the default target error (`planned`). The `lobes` method's curve is its
 //! pruning threshold at the planned quadtree depth and every other depth at the planned
 //! threshold, with the L2 cap fit and
 //! one lobe per occluder (instead of the default energy-preserving fit and quadtree mask)

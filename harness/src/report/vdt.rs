@@ -79,7 +79,7 @@ fn load_plan(w: usize, h: usize, u: &[f32], v: &[f32], r: &[f32]) -> Vec<usize> 
 /// Everything the section measures.
 #[derive(Clone, Debug)]
 pub struct VdtResults {
-    /// Exact signed EDT, ns per texel at [`BUILD_SIDE`]².
+    /// Exact signed EDT, ns per texel at `BUILD_SIDE`².
     pub edt_ns: f64,
     /// SAT build of the same map, ns per texel.
     pub sat_build_ns: f64,

@@ -1,5 +1,5 @@
 //! Scenes: spheres and planes with materials, spherical lights and an environment, a pinhole
-//! camera; read from JSON ([`file`]), rendered by the methods of [`render`] and compared
+//! camera; read from JSON ([`mod@file`]), rendered by the methods of [`render`] and compared
 //! with the path-traced reference of [`path`].
 //!
 //! Conventions (the scene-file contract, README "Scene files"):

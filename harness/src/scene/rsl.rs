@@ -4,7 +4,7 @@
 //!
 //! - The environment (times its scale) is resampled to a cube map of [`Options::face`]²
 //!   texels per face and decomposed into `K` RSLs by bottom-up merging
-//!   ([`crate::env::decompose`]).
+//!   ([`mod@crate::env::decompose`]).
 //! - BRDF SATs are fitted for what the scene's materials need: one for the diffuse part
 //!   (Lambert, albedo 1, times each material's diffuse RGB) and one per distinct specular
 //!   part ([`SpecKey`]): a Phong exponent, a GGX `(f0, α)` or a Lafortune lobe (modified
@@ -456,7 +456,7 @@ fn shade_by_part(
 /// [`render_built`] through the SIMD moments kernel: per row, each surface point's moment
 /// tables as in [`shade_point`], then eight points at a time through
 /// [`steradian_simd::rsl::shade::shade_moments_batch`] with the Lambert SAT and with each
-/// specular part's SAT ([`shade_by_part`]). Each pixel is within the kernel's
+/// specular part's SAT (`shade_by_part`). Each pixel is within the kernel's
 /// [`steradian_simd::rsl::shade::MOMENTS_REL_TOL`] of [`render_built`] (relative to the
 /// pixel's largest channel; the harness test asserts it). `Err` for a BRDF SAT the SIMD
 /// kernel does not take (anisotropic).
@@ -566,7 +566,7 @@ pub const GPU_BATCH: usize = 4096;
 
 /// [`render_built`] on the wgpu backend: the surface points' moment tables as in
 /// [`shade_point`] (CPU, in parallel), then `wgsl::SHADE_MOMENTS` for the Lambert SAT and
-/// each specular part's SAT ([`shade_by_part`], [`crate::shade::shade_moments_gpu_at`]),
+/// each specular part's SAT (`shade_by_part`, [`crate::shade::shade_moments_gpu_at`]),
 /// [`GPU_BATCH`] points at a time. Each pixel is within `steradian_core::wgsl::SHADE_MOMENTS_REL_TOL` of
 /// [`render_built`] (relative to the pixel's largest channel; the GPU scene test asserts
 /// it). `Err` for a device error or a BRDF SAT the kernel does not take (anisotropic).
