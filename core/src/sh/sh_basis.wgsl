@@ -83,37 +83,13 @@ fn sh_basis(d_in: vec3<f32>, bands: u32) {
     }
 }
 
-// The basis in `ybuf` at a cap's axis times each band's factor (mirrors
-// `sh::cap::band_scales`): k_l = √(4π/(2l+1))·L̃_l = 2π·sin²a·P_l′(cos a)/(l(l+1)),
-// k_0 = 4π·sin²(a/2), P_l′ by the derivative recurrence P′_{l+1} = P′_{l−1} + (2l+1)·P_l (a
-// sum of positive terms near cos a = 1: no cancellation for small caps), sin a from a/2 as
-// `sh::cap::cap_trig`. P_l itself by its recurrence on the differences d_l = P_l − P_{l−1}
-// with u = 1 − cos a = 2·sin²(a/2): (l+1)·d_{l+1} = l·d_l − (2l+1)·u·P_l (the Legendre
-// recurrence minus (l+1)·P_l), whose errors add where the plain one's grow like l² near
-// cos a = 1 (see `sh_basis`). `ybuf` then holds ∫_cap Y_l^m dω of the cap of half-angle `a`.
+// The basis in `ybuf` at a cap's axis times each band's factor `k_l` (`cap_factor_next`
+// of `sh_cap_factors.wgsl`, which must precede this file). `ybuf` then holds
+// ∫_cap Y_l^m dω of the cap of half-angle `a`.
 fn sh_cap_scale(a: f32, bands: u32) {
-    let sh = sin(0.5 * a);
-    let ch = cos(0.5 * a);
-    let s = 2.0 * sh * ch;
-    let s2 = s * s;
-    let u = 2.0 * sh * sh;
-    let pi = 3.14159265358979;
-    var p = 1.0 - u;
-    var d = -u;
-    var dp_prev = 0.0;
-    var dp = 1.0;
+    var f = cap_factors(a);
     for (var l = 0u; l < bands; l++) {
-        var k = 4.0 * pi * sh * sh;
-        if (l > 0u) {
-            let lf = f32(l);
-            k = 2.0 * pi * s2 * dp / (lf * (lf + 1.0));
-            let d_next = (lf * d - (2.0 * lf + 1.0) * u * p) / (lf + 1.0);
-            let dp_next = dp_prev + (2.0 * lf + 1.0) * p;
-            p = p + d_next;
-            d = d_next;
-            dp_prev = dp;
-            dp = dp_next;
-        }
+        let k = cap_factor_next(&f, l);
         for (var c = l * l; c < (l + 1u) * (l + 1u); c++) {
             ybuf[c] = ybuf[c] * k;
         }

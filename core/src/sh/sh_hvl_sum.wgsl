@@ -67,35 +67,17 @@ fn blocked(k: u32, o: vec3<f32>, d: vec3<f32>, t_max: f32) -> bool {
 
 // s = Σ_l F_l·C_l^0 of the cap of half-angle `a` whose axis is at cos θ = z from the
 // receiver's normal: C_l^0 = k_l·Y_l^0(z) with Y_l^0 = √((2l+1)/4π)·P_l(z) (the plain
-// Legendre recurrence: at most 16 bands) and k_l the cap factors of `sh_cap_scale`
-// (`sh_basis.wgsl`, the same recurrences), without the basis buffer: the m = 0 column is
-// all a zonal receiver reads.
+// Legendre recurrence: at most 16 bands) and k_l from `sh_cap_factors.wgsl`, without the
+// basis buffer: the m = 0 column is all a zonal receiver reads.
 fn zonal_cap_dot(z: f32, a: f32, n: u32, i: u32) -> f32 {
     let pi = 3.14159265358979;
-    let sh = sin(0.5 * a);
-    let ch = cos(0.5 * a);
-    let sn = 2.0 * sh * ch;
-    let s2 = sn * sn;
-    let u = 2.0 * sh * sh;
-    var p = 1.0 - u;
-    var d = -u;
-    var dp_prev = 0.0;
-    var dp = 1.0;
+    var f = cap_factors(a);
     var q_prev = 0.0;
     var q = 1.0;
     var sum = 0.0;
     for (var l = 0u; l < n; l++) {
         let lf = f32(l);
-        var k = 4.0 * pi * sh * sh;
-        if (l > 0u) {
-            k = 2.0 * pi * s2 * dp / (lf * (lf + 1.0));
-            let d_next = (lf * d - (2.0 * lf + 1.0) * u * p) / (lf + 1.0);
-            let dp_next = dp_prev + (2.0 * lf + 1.0) * p;
-            p = p + d_next;
-            d = d_next;
-            dp_prev = dp;
-            dp = dp_next;
-        }
+        let k = cap_factor_next(&f, l);
         let y = sqrt((2.0 * lf + 1.0) / (4.0 * pi)) * q;
         sum = sum + col(9u + l, i) * (y * k);
         let q_next = ((2.0 * lf + 1.0) * z * q - lf * q_prev) / (lf + 1.0);

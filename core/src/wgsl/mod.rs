@@ -214,6 +214,7 @@ pub const CP_QUERY_TOL: f32 = 1.0e-5;
 /// rationals on the GPU. Tolerance: [`SH_EVAL_TOL`].
 pub const SH_EVAL: &str = concat!(
     include_str!("batch.wgsl"),
+    include_str!("../sh/sh_cap_factors.wgsl"),
     include_str!("../sh/sh_basis.wgsl"),
     include_str!("../sh/sh_eval.wgsl")
 );
@@ -235,6 +236,7 @@ pub const SH_EVAL_TOL: f32 = 1.0e-5;
 /// [`ALL`]. Tolerance: [`SH_CAP_TOL`].
 pub const SH_CAP: &str = concat!(
     include_str!("batch.wgsl"),
+    include_str!("../sh/sh_cap_factors.wgsl"),
     include_str!("../sh/sh_basis.wgsl"),
     include_str!("../sh/sh_cap.wgsl")
 );
@@ -299,6 +301,7 @@ pub const SH_ROTATE_ZXZXZ_TOL: f32 = 5.0e-6;
 pub const SH_HVL: &str = concat!(
     include_str!("batch.wgsl"),
     include_str!("atan2.wgsl"),
+    include_str!("../sh/sh_cap_factors.wgsl"),
     include_str!("../sh/sh_basis.wgsl"),
     "const HVL_EXACT_HORIZON: bool = false;\n",
     include_str!("../sh/sh_hvl.wgsl")
@@ -311,6 +314,7 @@ pub const SH_HVL: &str = concat!(
 pub const SH_HVL_EXACT: &str = concat!(
     include_str!("batch.wgsl"),
     include_str!("atan2.wgsl"),
+    include_str!("../sh/sh_cap_factors.wgsl"),
     include_str!("../sh/sh_basis.wgsl"),
     "const HVL_EXACT_HORIZON: bool = true;\n",
     include_str!("../sh/sh_hvl.wgsl")
@@ -337,6 +341,7 @@ pub const SH_HVL_TOL: f32 = 2.0e-5;
 /// `tests/sh_gpu.rs` builds it. Tolerance: [`SH_HVL_SUM_TOL`].
 pub const SH_HVL_SUM: &str = concat!(
     include_str!("batch.wgsl"),
+    include_str!("../sh/sh_cap_factors.wgsl"),
     include_str!("../sh/sh_hvl_sum.wgsl")
 );
 /// Difference allowed between [`SH_HVL_SUM`] and the CPU sum per receiver, relative to the
@@ -352,6 +357,7 @@ pub const SH_HVL_SUM_TOL: f32 = 1.0e-4;
 /// [`ALL`]. Tolerance: [`SH_IRRADIANCE_TOL`].
 pub const SH_IRRADIANCE: &str = concat!(
     include_str!("batch.wgsl"),
+    include_str!("../sh/sh_cap_factors.wgsl"),
     include_str!("../sh/sh_basis.wgsl"),
     include_str!("../sh/sh_irradiance.wgsl")
 );
