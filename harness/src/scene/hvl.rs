@@ -18,9 +18,9 @@
 //! contribution of a unit HVL is computed once per pair and part and scaled in RGB by the
 //! light's radiance, the HVL's albedo and the part's scale. HVLs do not emit their glossy
 //! parts: emitting them (each part's `F′` at the HVL's light direction, as one more HVL
-//! at the same spot) was tried on `room` and moved its error by 1 % of itself, while each
-//! HVL's sharp lobe made the plan take 2.25× as many HVLs (face side 12 instead of 8 at 64
-//! columns). The paper does not test
+//! at the same spot) was tried on `room` and moved its error by under 1 % of itself, while
+//! each HVL's sharp lobe made the plan take 2.25× as many HVLs (face side 12 instead of 8
+//! at 64 columns). The paper does not test
 //! visibility between an HVL and the receiver; here a shadow ray per pair does by default
 //! ([`Options::visibility`]), which the harness measures on the `room` scene.
 
