@@ -879,8 +879,15 @@ fn hvl_plans_the_hvl_count_from_the_target_error() {
     assert_choice(&c.estimates, c.side, target);
     // The README's figure: side 8 (384 HVLs) on `room` at 64 columns.
     assert_eq!((planned.side, c.side), (8, 8));
+    // The receivers' bands by the same rule, with the planned HVLs (the README's figure: 3).
+    let b = hvl::choose_bands(&small.scene, &planned, target);
+    eprintln!("{b:?}");
+    assert_eq!(b.estimates.last(), Some(&(5, 0.0)));
+    assert_choice(&b.estimates, b.bands, target);
+    assert_eq!((planned.bands, b.bands), (3, 3));
     let loose = plan_at(&small.scene, render::Method::Hvl, 0.02).hvl;
     assert!(loose.side < planned.side, "{loose:?}");
+    assert!(loose.bands <= planned.bands, "{loose:?}");
     assert_eq!(
         plan_at(&small.scene, render::Method::Hvl, 1e-7).hvl.side,
         last

@@ -13,14 +13,14 @@
 //!
 //! **Emission and reception** (eq. 19–22, `steradian_core::sh::hvl::contribution`): an HVL
 //! reflects its surface's *diffuse* albedo (Lambertian emission, exact in one band); a
-//! receiver's diffuse albedo times the 5-band Lambert table, and each of its glossy parts
-//! times a BRDF SH table generated for it ([`Glossy`]). All are linear, so the scalar
-//! contribution of a unit HVL is computed once per pair and part and scaled in RGB by the
-//! light's radiance, the HVL's albedo and the part's scale. HVLs do not emit their glossy
-//! parts: emitting them (each part's `F′` at the HVL's light direction, as one more HVL
-//! at the same spot) was tried on `room` and moved its error by under 1 % of itself, while
-//! each HVL's sharp lobe made the plan take 2.25× as many HVLs (face side 12 instead of 8
-//! at 64 columns). The paper does not test
+//! receiver's diffuse albedo times the Lambert table (its first [`Options::bands`]), and
+//! each of its glossy parts times a BRDF SH table generated for it ([`Glossy`]). All are
+//! linear, so the scalar contribution of a unit HVL is computed once per pair and part and
+//! scaled in RGB by the light's radiance, the HVL's albedo and the part's scale. HVLs do
+//! not emit their glossy parts: emitting them (each part's `F′` at the HVL's light
+//! direction, as one more HVL at the same spot) was tried on `room` and moved its error
+//! by under 1 % of itself, while each HVL's sharp lobe made the plan take 2.25× as many
+//! HVLs (face side 12 instead of 8 at 64 columns). The paper does not test
 //! visibility between an HVL and the receiver; here a shadow ray per pair does by default
 //! ([`Options::visibility`]), which the harness measures on the `room` scene.
 
@@ -47,6 +47,9 @@ pub struct Options {
     /// Carry the receivers' glossy parts (Phong, Lafortune) through BRDF SH tables built
     /// for the scene's materials ([`Glossy`]); `false` keeps only the diffuse part.
     pub glossy: bool,
+    /// SH bands of the receivers' diffuse part: the first `bands` of the committed Lambert
+    /// table (at most its 5; planned by [`choose_bands`]).
+    pub bands: usize,
 }
 
 impl Default for Options {
@@ -56,6 +59,7 @@ impl Default for Options {
             direct: lobes::Options::default(),
             visibility: true,
             glossy: true,
+            bands: brdf::lambert().bands(),
         }
     }
 }
@@ -311,11 +315,11 @@ pub fn indirect(
     scene: &Scene,
     p: &ShadingPoint,
     hvls: &[Placed],
-    visibility: bool,
+    o: &Options,
     glossy: &GlossyViews<'_>,
     scratch: &mut Scratch,
 ) -> Rgb {
-    indirect_parts(scene, p, hvls, visibility, glossy, true, scratch)
+    indirect_parts(scene, p, hvls, o, glossy, true, scratch)
 }
 
 /// [`indirect`] with the diffuse part left out where `diffuse` is false (the wgpu path
@@ -324,7 +328,7 @@ fn indirect_parts(
     scene: &Scene,
     p: &ShadingPoint,
     hvls: &[Placed],
-    visibility: bool,
+    o: &Options,
     glossy: &GlossyViews<'_>,
     diffuse: bool,
     scratch: &mut Scratch,
@@ -349,7 +353,7 @@ fn indirect_parts(
         sh,
         glossy: gcoeffs,
     } = scratch;
-    let n = table.bands();
+    let n = o.bands.clamp(1, table.bands());
     if table
         .lookup_into(brdf::Part::WithCosine, theta, n, coeffs)
         .is_err()
@@ -417,7 +421,7 @@ fn indirect_parts(
         if !any {
             continue;
         }
-        if visibility {
+        if o.visibility {
             let to = h.hvl.position().as_dvec3() - origin;
             let d = to.length();
             let ray = Ray {
@@ -512,12 +516,12 @@ pub fn render_gpu(
     let views = glossy.views();
     let hvls = place(scene, o.side);
     let lambert = brdf::lambert();
-    let nb = lambert.bands();
+    let nb = o.bands.clamp(1, lambert.bands());
     let table = gpu_sum_table(scene, &hvls, nb, o.visibility);
     let new_state = || (ProductCounts::default(), Scratch::default());
     let (mut img, _) = render_centres(scene, bar, new_state, |(counts, scratch), p| {
         let d = lobes::shade(scene, p, &o.direct, counts);
-        let g = indirect_parts(scene, p, &hvls, o.visibility, &views, false, scratch);
+        let g = indirect_parts(scene, p, &hvls, o, &views, false, scratch);
         [d[0] + g[0], d[1] + g[1], d[2] + g[2]]
     });
     // The receivers with a diffuse part: pixel, albedo and the kernel's input row.
@@ -599,6 +603,22 @@ pub struct SideChoice {
 /// of the target is left to the direct light and to the HVL approximation itself. The
 /// largest candidate if none is within.
 pub fn choose_side(scene: &Scene, o: &Options, target: f64) -> SideChoice {
+    let images = probe_images(scene, o, &SIDE_CANDIDATES, |side| {
+        (place(scene, side), o.bands)
+    });
+    let (side, estimates) = super::plan_choice(&SIDE_CANDIDATES, &images, target)
+        .unwrap_or((SIDE_CANDIDATES[0], Vec::new()));
+    SideChoice { side, estimates }
+}
+
+/// The probes ([`super::probe_points`]) shaded with the direct light of `o` plus the
+/// indirect light of each candidate's HVLs and receiver bands (`setting(candidate)`).
+fn probe_images<T: Copy>(
+    scene: &Scene,
+    o: &Options,
+    candidates: &[T],
+    setting: impl Fn(T) -> (Vec<Placed>, usize),
+) -> Vec<Vec<Rgb>> {
     let probes = super::probe_points(scene);
     let mut counts = ProductCounts::default();
     let direct: Vec<Rgb> = probes
@@ -612,23 +632,46 @@ pub fn choose_side(scene: &Scene, o: &Options, target: f64) -> SideChoice {
         Glossy::none(scene)
     };
     let glossy = glossy.views();
-    let images: Vec<Vec<Rgb>> = SIDE_CANDIDATES
+    candidates
         .iter()
-        .map(|&side| {
-            let hvls = place(scene, side);
+        .map(|&c| {
+            let (hvls, bands) = setting(c);
+            let oc = Options { bands, ..*o };
             probes
                 .iter()
                 .zip(&direct)
                 .map(|(p, d)| {
-                    let i = indirect(scene, p, &hvls, o.visibility, &glossy, &mut scratch);
+                    let i = indirect(scene, p, &hvls, &oc, &glossy, &mut scratch);
                     [d[0] + i[0], d[1] + i[1], d[2] + i[2]]
                 })
                 .collect()
         })
-        .collect();
-    let (side, estimates) = super::plan_choice(&SIDE_CANDIDATES, &images, target)
-        .unwrap_or((SIDE_CANDIDATES[0], Vec::new()));
-    SideChoice { side, estimates }
+        .collect()
+}
+
+/// What [`choose_bands`] chose and what it measured.
+#[derive(Clone, Debug)]
+pub struct BandsChoice {
+    /// The chosen band count.
+    pub bands: usize,
+    /// `(bands, estimate)`: the probes' mean |difference| from the committed table's full 5
+    /// bands over its largest value ([`super::probe_estimates`]).
+    pub estimates: Vec<(usize, f64)>,
+}
+
+/// The fewest bands (1 to the committed Lambert table's 5) of the receivers' diffuse part
+/// that keep the probes within [`super::PLAN_SHARE`] of `target` of the full table's, with
+/// `o`'s HVLs (the rule of [`choose_side`]): the clamped cosine's zonal coefficients fall as
+/// `l^−2.5` and vanish for odd `l > 1`, so a loose target needs fewer bands than the
+/// paper's.
+pub fn choose_bands(scene: &Scene, o: &Options, target: f64) -> BandsChoice {
+    let full = brdf::lambert().bands();
+    let candidates: Vec<usize> = (1..=full).collect();
+    let hvls = place(scene, o.side);
+    let images = probe_images(scene, o, &candidates, |b| (hvls.clone(), b));
+    let (bands, estimates) =
+        super::plan_choice(&candidates, &images, target).unwrap_or((full, Vec::new()));
+    BandsChoice { bands, estimates }
 }
 
 /// Direct light by the `lobes` method plus one bounce from HVLs, one pixel-centre sample
@@ -644,7 +687,7 @@ pub fn render(scene: &Scene, o: &Options, bar: &ProgressBar) -> (Image, usize) {
     let new_state = || (ProductCounts::default(), Scratch::default());
     let (img, _) = render_centres(scene, bar, new_state, |(counts, scratch), p| {
         let d = lobes::shade(scene, p, &o.direct, counts);
-        let ind = indirect(scene, p, &hvls, o.visibility, &glossy, scratch);
+        let ind = indirect(scene, p, &hvls, o, &glossy, scratch);
         [d[0] + ind[0], d[1] + ind[1], d[2] + ind[2]]
     });
     (img, hvls.len())

@@ -359,12 +359,23 @@ pub fn plan(scene: &Scene, o: &Options) -> Result<Plan, String> {
                         est
                     ),
                 });
+                let bands = super::hvl::choose_bands(scene, &hv, o.target_error);
+                hv.bands = bands.bands;
                 p.push(PlanItem {
                     item: "sh_bands".into(),
-                    value: json!(steradian_core::sh::brdf::lambert().bands()),
-                    reason: "the receiver's diffuse albedo times the committed Lambert BRDF \
-                             table (with the cosine); Lambertian emission is exact in one band"
-                        .into(),
+                    value: json!(hv.bands),
+                    reason: format!(
+                        "the receiver's diffuse albedo times the first {} bands of the \
+                         committed Lambert BRDF table (with the cosine): the fewest that keep \
+                         {} probe pixels within {} of the target {} of its full {} ({}); \
+                         Lambertian emission is exact in one band",
+                        hv.bands,
+                        super::PROBES.0 * super::PROBES.1,
+                        super::PLAN_SHARE,
+                        o.target_error,
+                        steradian_core::sh::brdf::lambert().bands(),
+                        estimates_text("bands ", &bands.estimates)
+                    ),
                 });
                 let tables: Vec<String> = scene
                     .material_names
