@@ -72,6 +72,9 @@ pub(crate) trait Lanes:
     /// `0 ≤ i ≤ table.len() − 2`, `table.len() ≤ 2²⁴`; out-of-range lanes are clamped to
     /// `table.len() − 2`, and a table shorter than 2 panics).
     fn gather_pair(self, table: &[f32]) -> (Self, Self);
+    /// Each lane `as usize` (saturating: NaN and negatives to 0) into `out[..N]`, for
+    /// lanes below `2³¹` (one vector conversion instead of one per lane).
+    fn to_indices(self, out: &mut [usize; 16]);
 }
 
 macro_rules! impl_lanes {
@@ -188,6 +191,13 @@ macro_rules! impl_lanes {
                     h1[k] = table[j + 1];
                 }
                 ($t::new(h0), $t::new(h1))
+            }
+            #[inline(always)]
+            fn to_indices(self, out: &mut [usize; 16]) {
+                // `fast_trunc_int` gives `i32::MIN` for NaN: `max(0)` makes it 0, as `as`.
+                for (o, i) in out.iter_mut().zip(self.fast_trunc_int().to_array()) {
+                    *o = i.max(0) as usize;
+                }
             }
         }
     };
@@ -473,5 +483,32 @@ pub(crate) mod tests {
         let (h0, h1) = f32x8::new([0.0, 1.0, 8.0, 9.0, 100.0, 3.0, 4.0, 5.0]).gather_pair(&t);
         assert_eq!(h0.to_array(), [0.0, 1.0, 8.0, 8.0, 8.0, 3.0, 4.0, 5.0]);
         assert_eq!(h1.to_array(), [1.0, 2.0, 9.0, 9.0, 9.0, 4.0, 5.0, 6.0]);
+    }
+
+    /// `to_indices` is `as usize` lane by lane, at every lane of both widths, for the special
+    /// values below `2³¹` (NaN and negatives to 0, fractions truncated) and the largest
+    /// `f32` below `2³¹`.
+    #[test]
+    fn to_indices_is_as_usize() {
+        let below: Vec<f32> = VALUES
+            .iter()
+            .copied()
+            .filter(|v| v.is_nan() || *v < 2_147_483_648.0)
+            .chain([0.999_999_9, 16_777_215.0, 2_147_483_520.0])
+            .collect();
+        for &v in &below {
+            for k in 0..16 {
+                let lanes: [f32; 16] = core::array::from_fn(|j| if j == k { v } else { j as f32 });
+                let want: [usize; 16] = lanes.map(|x| x as usize);
+                let mut got = [usize::MAX; 16];
+                f32x16::new(lanes).to_indices(&mut got);
+                assert_eq!(got, want, "{v} in lane {k} of 16");
+                if k < 8 {
+                    let mut got8 = [usize::MAX; 16];
+                    f32x8::new(lanes[..8].try_into().unwrap()).to_indices(&mut got8);
+                    assert_eq!(got8[..8], want[..8], "{v} in lane {k} of 8");
+                }
+            }
+        }
     }
 }

@@ -137,14 +137,19 @@ fn gather_stencil<'t, W: Lanes>(
     // g[4·b + a][lane]: each vector is then one contiguous load (so the lane loop writes
     // lane `k` of 16 arrays, which an iterator over `g` cannot express).
     let mut g = [[0.0f32; 16]; 16];
+    // The indices of every lane, converted a vector at a time.
+    let (mut cols, mut rows) = ([[0usize; 16]; 4], [[0usize; 16]; 4]);
+    for ((c, x), (r, y)) in cols.iter_mut().zip(ix).zip(rows.iter_mut().zip(jy)) {
+        x.to_indices(c);
+        y.to_indices(r);
+    }
     #[allow(clippy::needless_range_loop)]
     for k in 0..W::N {
         let d = table(k);
-        let cols: [usize; 4] = core::array::from_fn(|a| ix[a].lanes()[k] as usize);
-        for (b, y) in jy.iter().enumerate() {
-            let row = y.lanes()[k] as usize * w;
-            for (a, &c) in cols.iter().enumerate() {
-                g[4 * b + a][k] = d.get(row + c).copied().unwrap_or(0.0);
+        for (b, r) in rows.iter().enumerate() {
+            let row = r[k] * w;
+            for (a, c) in cols.iter().enumerate() {
+                g[4 * b + a][k] = d.get(row + c[k]).copied().unwrap_or(0.0);
             }
         }
     }
