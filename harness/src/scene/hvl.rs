@@ -428,7 +428,7 @@ fn indirect_parts(
                 o: origin,
                 d: to / d,
             };
-            if scene.occluded(&ray, 0.0, d * (1.0 - 1e-4)) {
+            if scene.occluded(&ray, 0.0, d * (1.0 - f64::from(SHADOW_EPS))) {
                 continue;
             }
         }
@@ -450,9 +450,9 @@ fn indirect_parts(
     out
 }
 
-/// The shadow rays of the wgpu path stop at `d·(1 − ε)` before the HVL, as [`indirect`]'s
-/// do.
-const GPU_SUM_EPS: f32 = 1e-4;
+/// The shadow rays of both paths stop at `d·(1 − ε)` before the HVL (which lies on a
+/// surface the ray would otherwise end on).
+const SHADOW_EPS: f32 = 1e-4;
 
 /// Receivers per dispatch of the wgpu path.
 pub const GPU_BATCH: usize = 4096;
@@ -466,7 +466,7 @@ fn gpu_sum_table(scene: &Scene, hvls: &[Placed], bands: usize, visibility: bool)
         scene.objects.len() as f32,
         bands as f32,
         if visibility { 1.0 } else { 0.0 },
-        GPU_SUM_EPS,
+        SHADOW_EPS,
     ];
     for h in hvls {
         let (p, n) = (h.hvl.position(), h.hvl.frame().normal());
