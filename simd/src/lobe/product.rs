@@ -296,11 +296,15 @@ fn correction<W: Lanes>(table: &ProductTable<'_>, u1: W, u2: W, w: W) -> W {
     let (i, fi) = cell(u1, ne);
     let (j, fj) = cell(u2, ne);
     let (k, fk) = cell(w, na);
-    let (il, jl, kl) = (i.lanes(), j.lanes(), k.lanes());
+    // The cell indices of every lane, converted a vector at a time (`as usize`: NaN lanes
+    // index 0; their result is replaced below).
+    let (mut il, mut jl, mut kl) = ([0usize; 16], [0usize; 16], [0usize; 16]);
+    i.to_indices(&mut il);
+    j.to_indices(&mut jl);
+    k.to_indices(&mut kl);
     let mut g = [[0.0f32; 16]; 8];
     for lane in 0..W::N {
-        // NaN lanes index 0 (`as` saturates); their result is replaced below.
-        let (i, j, k) = (il[lane] as usize, jl[lane] as usize, kl[lane] as usize);
+        let (i, j, k) = (il[lane], jl[lane], kl[lane]);
         let base = |a: usize, b: usize| {
             let (lo, hi) = if a <= b { (a, b) } else { (b, a) };
             (hi * (hi + 1) / 2 + lo) * na + k

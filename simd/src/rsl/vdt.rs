@@ -245,15 +245,18 @@ fn query_lanes<W: Lanes>(view: &VdtView<'_>, [u, v, r]: [W; 3]) -> [W; 2] {
     // Eq. 9 of the bilinear D.
     let (i0, fx) = axis(u, w);
     let (j0, fy) = axis(v, h);
-    // Gather: `as usize` saturates and maps NaN to 0, as in the scalar kernel.
-    let (ia, ja) = (i0.lanes(), j0.lanes());
+    // Gather: `as usize` saturates and maps NaN to 0, as in the scalar kernel (converted a
+    // vector at a time).
+    let (mut ia, mut ja) = ([0usize; 16], [0usize; 16]);
+    i0.to_indices(&mut ia);
+    j0.to_indices(&mut ja);
     // `i0 ≤ w − 2` when `w ≥ 2`, so the scalar `i1 = min(i0 + 1, w − 1)` is `i0 + 1`, and
     // `i0` itself when `w = 1`: constant steps to the other three samples.
     let di = usize::from(w >= 2);
     let dj = if h >= 2 { w } else { 0 };
     let mut base = [0usize; 16];
     for (k, b) in base.iter_mut().take(W::N).enumerate() {
-        *b = ja[k] as usize * w + ia[k] as usize;
+        *b = ja[k] * w + ia[k];
     }
     let at = |k: usize, off: usize| -> f32 { d.get(base[k] + off).copied().unwrap_or(0.0) };
     let d00 = W::from_fn(|k| at(k, 0));
