@@ -38,7 +38,7 @@ trait F64Lanes: Copy + Add<Output = Self> + Sub<Output = Self> + Mul<Output = Se
 }
 
 macro_rules! lanes_kernels {
-    ($t:ident, $n:literal, $eval:ident, $narrow:ident, $unit:ident, $words:literal) => {
+    ($t:ident, $n:literal, $eval:ident, $narrow:ident, $point:ident, $words:literal) => {
         impl F64Lanes for $t {
             #[inline(always)]
             fn splat(v: f64) -> Self {
@@ -54,7 +54,7 @@ macro_rules! lanes_kernels {
         pub fn $eval(dirs: [Vec3; $n], bands: usize, out: &mut [[f32; $n]]) -> Result<(), Error> {
             check_shape(bands, out.len())?;
             let lanes = |f: fn(&Vec3) -> f32| $t::new(dirs.each_ref().map(|d| f64::from(f(d))));
-            let u = $unit(lanes(|d| d.x), lanes(|d| d.y), lanes(|d| d.z));
+            let u = $point(lanes(|d| d.x), lanes(|d| d.y), lanes(|d| d.z));
             fill(u, bands, &mut |k, v| out[k] = $narrow(v));
             Ok(())
         }
@@ -70,7 +70,7 @@ macro_rules! lanes_kernels {
         /// operations (`r²` summed left to right, one square root and one division), `+z`
         /// with `r² = 1/√r² = 1` where `r² = 0`, NaN where `r²` is not finite.
         #[inline(always)]
-        fn $unit(x: $t, y: $t, z: $t) -> [$t; 5] {
+        fn $point(x: $t, y: $t, z: $t) -> [$t; 5] {
             let r2 = x * x + y * y + z * z;
             let zero = r2.simd_eq($t::ZERO);
             let finite = r2.simd_lt($t::splat(f64::INFINITY));
@@ -82,8 +82,8 @@ macro_rules! lanes_kernels {
     };
 }
 
-lanes_kernels!(f64x4, 4, eval_x4, narrow4, unit_lanes4, "four");
-lanes_kernels!(f64x8, 8, eval_x8, narrow8, unit_lanes8, "eight");
+lanes_kernels!(f64x4, 4, eval_x4, narrow4, point_lanes4, "four");
+lanes_kernels!(f64x8, 8, eval_x8, narrow8, point_lanes8, "eight");
 
 /// The scalar kernel's recurrence (`steradian_core::sh`'s `fill`) on the lanes;
 /// `put(k, v)` receives coefficient `k` (the sine part of each `(l, m)` before its cosine
@@ -103,7 +103,7 @@ fn fill<F: F64Lanes>(u: [F; 5], bands: usize, put: &mut impl FnMut(usize, F)) {
         8 => fixed::fill_8(form(u, 8), put),
         9 => fixed::fill_9(form(u, 9), put),
         10 => fixed::fill_10(form(u, 10), put),
-        _ if bands > HOMOGENEOUS_MAX_BANDS => fill_loop::<false, F>(form(u, MAX_BANDS), bands, put),
+        _ if bands > HOMOGENEOUS_MAX_BANDS => fill_loop::<false, F>(form(u, bands), bands, put),
         _ => fill_short(u, bands, put),
     }
 }
@@ -206,13 +206,13 @@ pub const SLICE_LANES: usize = slice_lanes::N;
 /// Lanes of [`eval_slices`]: `f64x8` where the build enables AVX-512F, `f64x4` otherwise.
 #[cfg(target_feature = "avx512f")]
 mod slice_lanes {
-    pub(super) use super::{narrow8 as narrow, unit_lanes8 as unit_lanes};
+    pub(super) use super::{narrow8 as narrow, point_lanes8 as point_lanes};
     pub(super) use wide::f64x8 as L;
     pub(super) const N: usize = 8;
 }
 #[cfg(not(target_feature = "avx512f"))]
 mod slice_lanes {
-    pub(super) use super::{narrow4 as narrow, unit_lanes4 as unit_lanes};
+    pub(super) use super::{narrow4 as narrow, point_lanes4 as point_lanes};
     pub(super) use wide::f64x4 as L;
     pub(super) const N: usize = 4;
 }
@@ -271,13 +271,13 @@ fn columns_any(x: &[f32], y: &[f32], z: &[f32], bands: usize, out: &mut [f32]) {
 /// (the loop), slower for the straight-line code (`steradian report --section sh`).
 #[inline(always)]
 fn columns<const OWN: bool>(x: &[f32], y: &[f32], z: &[f32], bands: usize, out: &mut [f32]) {
-    use slice_lanes::{L, N, narrow, unit_lanes};
+    use slice_lanes::{L, N, narrow, point_lanes};
     let len = x.len();
     // Whole groups of lanes: one store of `N` values per coefficient.
     let whole = len - len % N;
     let col = |v: &[f32], i: usize| L::new(core::array::from_fn(|k| f64::from(v[i + k])));
     for i in (0..whole).step_by(N) {
-        let u = unit_lanes(col(x, i), col(y, i), col(z, i));
+        let u = point_lanes(col(x, i), col(y, i), col(z, i));
         if OWN {
             let dst = &mut *out;
             fill(u, bands, &mut move |c, v| {
@@ -299,7 +299,7 @@ fn columns<const OWN: bool>(x: &[f32], y: &[f32], z: &[f32], bands: usize, out: 
                 f64::from(if k < live { v[whole + k] } else { fill })
             }))
         };
-        let u = unit_lanes(pad(x, 0.0), pad(y, 0.0), pad(z, 1.0));
+        let u = point_lanes(pad(x, 0.0), pad(y, 0.0), pad(z, 1.0));
         fill(u, bands, &mut |c, v| {
             let at = c * len + whole;
             out[at..at + live].copy_from_slice(&narrow(v)[..live]);
