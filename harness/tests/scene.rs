@@ -446,10 +446,11 @@ fn hvl_method_against_the_path_tracer_on_a_small_room() {
     // The README's table size for the room's Phong 40.
     let g = hvl::Glossy::build(s);
     let sizes: Vec<(usize, usize)> = g
+        .views()
         .parts
         .iter()
         .flatten()
-        .map(|p| (p.bands, p.samples))
+        .map(|(t, _)| (t.bands(), t.samples()))
         .collect();
     assert_eq!(sizes, [(16, 90)]);
     let direct = m(&lobes::render(s, &d.direct, &hidden).0);

@@ -32,7 +32,6 @@ use steradian_core::lobe::sum::ProductCounts;
 use steradian_core::sh::{brdf, hvl as core_hvl};
 
 use super::image::Image;
-use super::material::Material;
 use super::{Kind, Ray, Rgb, Scene, ShadingPoint, lobes, path, render_centres};
 
 /// Settings of the `hvl` method.
@@ -191,19 +190,15 @@ pub const GLOSSY_TARGET: f64 = crate::generate::brdf_sh::TARGET;
 pub struct GlossyPart {
     /// The table's file bytes (`steradian_core::sh::brdf` format).
     pub table: Vec<u8>,
-    /// Its band count.
-    pub bands: usize,
-    /// Its view samples.
-    pub samples: usize,
     /// Phong's `specular`, a Lafortune lobe's `ρ`.
     pub scale: Rgb,
 }
 
-/// The glossy parts of every material of a scene, by material index: a modified Phong
-/// material's specular term (`k_s = 1`, its exponent) and each lobe of a Lafortune
-/// material (`ρ = 1`), each projected by `generate::brdf_sh` with the fewest bands and
-/// views that meet [`GLOSSY_TARGET`] (tables shared between identical parts). Lambert
-/// materials have none; GGX is not carried by this method.
+/// The glossy parts of every material of a scene, by material index: the specular parts of
+/// [`super::rsl::specular_parts`] (a modified Phong material's specular term with `k_s = 1`,
+/// each lobe of a Lafortune material with `ρ = 1`), each projected by `generate::brdf_sh`
+/// with the fewest bands and views that meet [`GLOSSY_TARGET`] (tables shared between
+/// identical parts). Lambert materials have none; GGX is not carried by this method.
 pub struct Glossy {
     /// Per material, its parts.
     pub parts: Vec<Vec<GlossyPart>>,
@@ -219,60 +214,47 @@ impl Glossy {
 
     /// The tables of `scene`'s materials (module docs of [`Glossy`]).
     pub fn build(scene: &Scene) -> Glossy {
+        use super::rsl::{SpecKey, specular_parts};
         use crate::generate::brdf_sh as gen_sh;
         use steradian_reference::lobe::brdf::Model;
         // One table per distinct part and process: the plan's probes and the render use the
         // same tables, and a generation costs seconds.
-        type Cache = Vec<([u64; 4], usize, usize, Vec<u8>)>;
-        static BUILT: std::sync::Mutex<Cache> = std::sync::Mutex::new(Vec::new());
-        let table_of = |key: [u64; 4], model: Model| {
+        static BUILT: std::sync::Mutex<Vec<(SpecKey, Vec<u8>)>> = std::sync::Mutex::new(Vec::new());
+        let table_of = |key: SpecKey| -> Option<Vec<u8>> {
+            let f = f64::from_bits;
+            let model = match key {
+                SpecKey::Phong(e) => Model::Phong {
+                    kd: 0.0,
+                    ks: 1.0,
+                    e: f(e),
+                },
+                SpecKey::Lafortune(c, cz, e) => Model::Lafortune {
+                    lobes: [[f(c), f(c), f(cz), f(e), 1.0], [0.0; 5]],
+                },
+                SpecKey::Ggx(..) => return None,
+            };
             let mut built = BUILT.lock().unwrap_or_else(|e| e.into_inner());
-            if let Some((_, n, t, bytes)) = built.iter().find(|b| b.0 == key) {
-                return (bytes.clone(), *n, *t);
+            if let Some((_, bytes)) = built.iter().find(|b| b.0 == key) {
+                return Some(bytes.clone());
             }
             let n = gen_sh::choose_bands(&model, GLOSSY_TARGET);
             let t = gen_sh::choose_samples(&model, n, GLOSSY_TARGET);
             let bytes = gen_sh::table(&model, n, t);
-            built.push((key, n, t, bytes.clone()));
-            (bytes, n, t)
+            built.push((key, bytes.clone()));
+            Some(bytes)
         };
         let parts = scene
             .materials
             .iter()
-            .map(|m| match m {
-                Material::Phong {
-                    specular, exponent, ..
-                } => {
-                    let model = Model::Phong {
-                        kd: 0.0,
-                        ks: 1.0,
-                        e: *exponent,
-                    };
-                    let (table, bands, samples) = table_of([0, exponent.to_bits(), 0, 0], model);
-                    vec![GlossyPart {
-                        table,
-                        bands,
-                        samples,
-                        scale: *specular,
-                    }]
-                }
-                Material::Lafortune { lobes, .. } => lobes
-                    .iter()
-                    .map(|l| {
-                        let model = Model::Lafortune {
-                            lobes: [[l.c, l.c, l.cz, l.exponent, 1.0], [0.0; 5]],
-                        };
-                        let key = [1, l.c.to_bits(), l.cz.to_bits(), l.exponent.to_bits()];
-                        let (table, bands, samples) = table_of(key, model);
-                        GlossyPart {
-                            table,
-                            bands,
-                            samples,
-                            scale: l.rho,
-                        }
+            .map(|m| {
+                specular_parts(m)
+                    .filter_map(|(key, scale)| {
+                        Some(GlossyPart {
+                            table: table_of(key)?,
+                            scale,
+                        })
                     })
-                    .collect(),
-                Material::Lambert { .. } | Material::Ggx { .. } => Vec::new(),
+                    .collect()
             })
             .collect();
         Glossy { parts }
@@ -322,6 +304,29 @@ pub fn indirect(
     indirect_parts(scene, p, hvls, o, glossy, true, scratch)
 }
 
+/// A receiver's view frame and `θₒ`, with the first `n` (clamped to 1 ..= the committed
+/// Lambert table's bands) zonal coefficients `F_l = F_l^0` of that table at `θₒ` in
+/// `zonal[..n]` (`coeffs`: scratch of at least `n²`); `None` where the point has no view
+/// frame.
+fn lambert_zonal(
+    p: &ShadingPoint,
+    n: usize,
+    coeffs: &mut [f32],
+    zonal: &mut [f32],
+) -> Option<(steradian_core::frame::Frame, f32, usize)> {
+    let table = brdf::lambert();
+    let frame = brdf::view_frame(p.n.as_vec3(), p.wo.as_vec3()).ok()?;
+    let theta = frame.to_local(p.wo.as_vec3()).z.clamp(-1.0, 1.0).acos();
+    let n = n.clamp(1, table.bands());
+    table
+        .lookup_into(brdf::Part::WithCosine, theta, n, coeffs)
+        .ok()?;
+    for (l, z) in zonal.iter_mut().enumerate().take(n) {
+        *z = coeffs[l * l + l];
+    }
+    Some((frame, theta, n))
+}
+
 /// [`indirect`] with the diffuse part left out where `diffuse` is false (the wgpu path
 /// sums it on the GPU and only the glossy parts here).
 fn indirect_parts(
@@ -333,7 +338,6 @@ fn indirect_parts(
     diffuse: bool,
     scratch: &mut Scratch,
 ) -> Rgb {
-    let table = brdf::lambert();
     let albedo = if diffuse {
         scene.materials[p.material].diffuse()
     } else {
@@ -343,26 +347,15 @@ fn indirect_parts(
         .parts
         .get(p.material)
         .map_or(&[][..], |v| v.as_slice());
-    let Ok(frame) = brdf::view_frame(p.n.as_vec3(), p.wo.as_vec3()) else {
-        return [0.0; 3];
-    };
-    let theta = frame.to_local(p.wo.as_vec3()).z.clamp(-1.0, 1.0).acos();
     let Scratch {
         coeffs,
         zonal,
         sh,
         glossy: gcoeffs,
     } = scratch;
-    let n = o.bands.clamp(1, table.bands());
-    if table
-        .lookup_into(brdf::Part::WithCosine, theta, n, coeffs)
-        .is_err()
-    {
+    let Some((frame, theta, n)) = lambert_zonal(p, o.bands, coeffs, zonal) else {
         return [0.0; 3];
-    }
-    for (l, z) in zonal.iter_mut().enumerate().take(n) {
-        *z = coeffs[l * l + l];
-    }
+    };
     // Each glossy part's `F` in the view frame (a part whose table cannot be read or looked
     // up is left out: the tables are built by `Glossy::build`, so this does not happen).
     gcoeffs.resize_with(parts.len(), Vec::new);
@@ -515,8 +508,7 @@ pub fn render_gpu(
     };
     let views = glossy.views();
     let hvls = place(scene, o.side);
-    let lambert = brdf::lambert();
-    let nb = o.bands.clamp(1, lambert.bands());
+    let nb = o.bands.clamp(1, brdf::lambert().bands());
     let table = gpu_sum_table(scene, &hvls, nb, o.visibility);
     let new_state = || (ProductCounts::default(), Scratch::default());
     let (mut img, _) = render_centres(scene, bar, new_state, |(counts, scratch), p| {
@@ -528,7 +520,7 @@ pub fn render_gpu(
     let cam = scene.camera;
     let (w, h) = (cam.width as usize, cam.height as usize);
     let mut rows: Vec<(usize, Rgb, Vec<f32>)> = Vec::new();
-    let mut coeffs = vec![0.0f32; nb * nb];
+    let (mut coeffs, mut zonal) = (vec![0.0f32; nb * nb], vec![0.0f32; nb]);
     for j in 0..h {
         for i in 0..w {
             let super::Seen::Surface(p) = scene.see(&cam.centre_ray(i as u32, j as u32)) else {
@@ -538,21 +530,14 @@ pub fn render_gpu(
             if albedo.iter().all(|&a| a == 0.0) {
                 continue;
             }
-            let Ok(frame) = brdf::view_frame(p.n.as_vec3(), p.wo.as_vec3()) else {
+            let Some((frame, _, _)) = lambert_zonal(&p, nb, &mut coeffs, &mut zonal) else {
                 continue;
             };
-            let theta = frame.to_local(p.wo.as_vec3()).z.clamp(-1.0, 1.0).acos();
-            if lambert
-                .lookup_into(brdf::Part::WithCosine, theta, nb, &mut coeffs)
-                .is_err()
-            {
-                continue;
-            }
             let origin = path::offset(p.x, p.n);
             let (x, n) = (p.x.as_vec3(), frame.normal());
             let mut row = vec![x.x, x.y, x.z, n.x, n.y, n.z];
             row.extend([origin.x as f32, origin.y as f32, origin.z as f32]);
-            row.extend((0..nb).map(|l| coeffs[l * l + l]));
+            row.extend(&zonal[..nb]);
             rows.push((j * w + i, albedo, row));
         }
     }

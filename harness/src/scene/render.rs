@@ -377,13 +377,14 @@ pub fn plan(scene: &Scene, o: &Options) -> Result<Plan, String> {
                         estimates_text("bands ", &bands.estimates)
                     ),
                 });
+                let views = glossy.views();
                 let tables: Vec<String> = scene
                     .material_names
                     .iter()
-                    .zip(&glossy.parts)
+                    .zip(&views.parts)
                     .flat_map(|(name, parts)| {
-                        parts.iter().map(move |g| {
-                            format!("{name}: {} bands × {} views", g.bands, g.samples)
+                        parts.iter().map(move |(t, _)| {
+                            format!("{name}: {} bands × {} views", t.bands(), t.samples())
                         })
                     })
                     .collect();
