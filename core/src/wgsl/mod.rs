@@ -337,8 +337,9 @@ pub const SH_HVL_TOL: f32 = 2.0e-5;
 /// method's wgpu path. Input columns `[x, y, z, n (3), origin (3), F_0 … F_{n−1}]` (the
 /// receiver, its normal, the shadow rays' origin, its zonal `F`), output
 /// three columns; binding 3 holds the HVLs and occluders (layout in `sh_hvl_sum.wgsl`),
-/// `n ≤ 16` bands. Not a registered kernel (no `eval` contract); the harness test
-/// `tests/sh_gpu.rs` builds it. Tolerance: [`SH_HVL_SUM_TOL`].
+/// `n ≤ 16` bands. Not a registered kernel (no `eval` contract); the harness tests
+/// `tests/wgsl_validate.rs` (naga) and `tests/scene.rs` (`hvl_gpu_path_matches_the_cpu_path`,
+/// on an adapter) build it. Tolerance: [`SH_HVL_SUM_TOL`].
 pub const SH_HVL_SUM: &str = concat!(
     include_str!("batch.wgsl"),
     include_str!("../sh/sh_cap_factors.wgsl"),

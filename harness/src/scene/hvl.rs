@@ -18,9 +18,9 @@
 //! linear, so the scalar contribution of a unit HVL is computed once per pair and part and
 //! scaled in RGB by the light's radiance, the HVL's albedo and the part's scale. HVLs do
 //! not emit their glossy parts: emitting them (each part's `F′` at the HVL's light
-//! direction, as one more HVL at the same spot) was tried on `room` and moved its error
-//! by under 1 % of itself, while each HVL's sharp lobe made the plan take 2.25× as many
-//! HVLs (face side 12 instead of 8 at 64 columns). The paper does not test
+//! direction, as one more HVL at the same spot) was tried on `room`, where it barely moved
+//! the error while each HVL's sharp emission lobe made the plan ask for many more HVLs.
+//! The paper does not test
 //! visibility between an HVL and the receiver; here a shadow ray per pair does by default
 //! ([`Options::visibility`]), which the harness measures on the `room` scene.
 
@@ -486,11 +486,10 @@ fn gpu_sum_table(scene: &Scene, hvls: &[Placed], bands: usize, visibility: bool)
 /// diffuse sum over the HVLs by `steradian_core::wgsl::SH_HVL_SUM` ([`GPU_BATCH`] receivers
 /// per dispatch, the shadow rays against the scene's spheres and planes in `f32` from the
 /// CPU path's origin, skipping the object the HVL lies on: in `f32` a ray grazing a plane
-/// toward an HVL on it meets the plane before its end),
-/// times the receiver's diffuse
+/// toward an HVL on it meets the plane before its end), times the receiver's diffuse
 /// albedo. Each receiver's sum is within `steradian_core::wgsl::SH_HVL_SUM_TOL` of the
 /// CPU's wherever no shadow ray flips between `f32` and `f64` (harness test
-/// `tests/sh_gpu.rs`).
+/// `hvl_gpu_path_matches_the_cpu_path` in `tests/scene.rs`).
 ///
 /// Errors: the kernel's.
 pub fn render_gpu(

@@ -202,9 +202,10 @@ pub fn choose_k(scene: &Scene, o: &Options, target: f64) -> Result<KChoice, Stri
         specular,
     } = build_many(scene, o, &ks)?;
     let mut cov = vec![0.0f32; o.vis_side * o.vis_side];
-    let probes: Vec<_> = super::probe_points(scene)
-        .into_iter()
-        .filter_map(|p| point_moments(scene, o, &p, &mut cov).map(|t| (p, t)))
+    let points = super::probe_points(scene);
+    let probes: Vec<_> = points
+        .iter()
+        .filter_map(|p| point_moments(scene, o, p, &mut cov).map(|t| (p, t)))
         .collect();
     // The probes shaded with each K's lights (the SATs shared).
     let mut b = Built {
@@ -229,7 +230,6 @@ pub fn choose_k(scene: &Scene, o: &Options, target: f64) -> Result<KChoice, Stri
     // The visibility-map side with the chosen K's lights.
     let pos = order.iter().position(|&c| c == k).unwrap_or(0);
     b.lights = lights_of.swap_remove(pos);
-    let points = super::probe_points(scene);
     let side_images: Vec<Vec<Rgb>> = VIS_SIDE_CANDIDATES
         .iter()
         .map(|&side| {
