@@ -335,11 +335,12 @@ pub const SH_HVL_TOL: f32 = 2.0e-5;
 /// each contribution clamped at 0, summed with each HVL's RGB weight), with an optional
 /// shadow ray per HVL–receiver pair against sphere and plane occluders: the `hvl` scene
 /// method's wgpu path. Input columns `[x, y, z, n (3), origin (3), F_0 … F_{n−1}]` (the
-/// receiver, its normal, the shadow rays' origin, its zonal `F`), output
-/// three columns; binding 3 holds the HVLs and occluders (layout in `sh_hvl_sum.wgsl`),
-/// `n ≤ 16` bands. Not a registered kernel (no `eval` contract); the harness tests
-/// `tests/wgsl_validate.rs` (naga) and `tests/scene.rs` (`hvl_gpu_path_matches_the_cpu_path`,
-/// on an adapter) build it. Tolerance: [`SH_HVL_SUM_TOL`].
+/// receiver, its normal, the shadow rays' origin, its zonal `F`), output three columns;
+/// binding 3 holds the HVLs and occluders (layout in `sh_hvl_sum.wgsl`), `n ≤ 16` bands
+/// (checked at the committed Lambert table's 5). Not a registered kernel (no `eval`
+/// contract); the harness tests `tests/wgsl_validate.rs` (naga) and `tests/scene.rs`
+/// (`hvl_gpu_path_matches_the_cpu_path`, on an adapter) build it. Tolerance:
+/// [`SH_HVL_SUM_TOL`].
 pub const SH_HVL_SUM: &str = concat!(
     include_str!("batch.wgsl"),
     include_str!("../sh/sh_cap_factors.wgsl"),
