@@ -6,9 +6,10 @@
 //! b_k)` with `a_k`, `b_k` lane `k` of the inputs as [`LobeX8::to_array`] builds them
 //! (`CosineLobe::saturating`: the axis normalised, a zero axis replaced by `+z`, a negative
 //! exponent clamped to 0). The kernel performs the scalar kernel's operations in the same
-//! order; only the transcendental functions differ (wide's polynomial `ln`, `ln_1p`,
-//! `exp`, `exp_m1` and `atan2` instead of the standard library's; `ln` extended to
-//! subnormal arguments, `exp` to subnormal results), so:
+//! order; only the transcendental functions differ (wide's polynomial `ln`, `exp`,
+//! `exp_m1` and `atan2` instead of the scalar kernel's four-lane `ln_x4`, `exp_x4` and
+//! `atan2_pos` and the standard library's; `ln` extended to subnormal arguments, `exp` to
+//! subnormal results), so:
 //!
 //! - the **axis** comes from correctly rounded operations only (the arc frame, the peak's
 //!   `(cos t*, sin t*)`, the final normalisation): it is **bit-identical** to the scalar
@@ -134,37 +135,50 @@ fn one_pm_cos<W: Lanes>(sn: W, cs: W) -> (W, W) {
     (hz.select(one, omc), hz.select(one, opc))
 }
 
-/// The scalar `peak_pair`.
+/// One lane of the scalar kernel's `arcs` (see there): the doubled angle from an axis or a
+/// horizon to a peak, for exponents `(a, b)` of the two lobes, `r = ±(b − a)` and `c4 = ±c`
+/// as that lane has them; everything times `n = a + b`. Returns `(sn, cs, 1 − cos, 1 + cos)`.
 #[inline(always)]
-fn peak_pair<W: Lanes>(s: W, c: W, r: W, omr2: W, cy: W) -> (W, W) {
-    let zero = W::splat(0.0);
-    let rc = -r * c;
+fn arc<W: Lanes>(a: W, b: W, r: W, c4: W, c: W, s: W) -> (W, W, W, W) {
+    let (zero, one) = (W::splat(0.0), W::splat(1.0));
+    // The scalar `pow2_range`: n into [2⁻²⁰, 2²⁰] by an exact power of two.
+    let p = |e: i32| W::splat(f32::from_bits(((127 + e) as u32) << 23));
+    let n = a + b;
+    let k = n.lt(p(-20)).select(
+        n.lt(p(-60)).select(p(100), p(64)),
+        n.gt(p(20)).select(n.gt(p(60)).select(p(-100), p(-40)), one),
+    );
+    let (a, b, r) = (a * k, b * k, r * k);
+    let n = a + b;
+    let ab4 = W::splat(4.0) * a * b;
+    let cy = (n * n * (c * c) + ab4 * (s * s)).sqrt();
+    let rc = -r * c4;
     let den = cy + rc;
-    let sn_pos = den.gt(zero).select(s * omr2 / den, zero);
-    let sn = rc.ge(zero).select(sn_pos, s * (cy - rc));
-    let cs = c * cy - r * s * s;
-    (sn, cs)
+    let pos = den.gt(zero).select(s * ab4 / den, zero);
+    let sn = rc.ge(zero).select(pos, s * (cy - rc));
+    let cs = c4 * cy - r * s * s;
+    let h = n * (c * c + s * s);
+    let d = h + cs.abs();
+    let (small, big) = (sn * sn / (h * d), d / h);
+    let cpos = cs.ge(zero);
+    let hz = h.eq(zero);
+    let omc = hz.select(one, cpos.select(small, big));
+    let opc = hz.select(one, cpos.select(big, small));
+    (sn, cs, omc, opc)
 }
 
-/// The scalar `ratio`: `(r, 1 − r²)`.
+/// The scalar kernel's logarithm of a lane of `arcs`: `½·ln(1 + x)`, `x = −p/2`, where
+/// `p < q` (as `ln(u)·x/(u − 1)`, `u = 1 + x`), else `½·ln(q/2)`; `(p, q) = (1 − cos, 1 +
+/// cos)` gives `ln cos θ`, swapped `ln sin θ`.
 #[inline(always)]
-fn ratio<W: Lanes>(f1: W, f2: W) -> (W, W) {
-    let n = f1 + f2;
-    ((f2 - f1) / n, W::splat(4.0) * (f1 / n) * (f2 / n))
-}
-
-/// The scalar `ln_cos_half`: `½·log1p(−omc/2)` where `omc < opc`, else `½·ln(opc/2)`, with
-/// one `ln` per lane (wide's `ln_1p` is `ln(u)·x/(u − 1)`, `u = 1 + x`, spelled out here
-/// with the argument of the `ln` chosen per lane).
-#[inline(always)]
-fn ln_cos_half<W: Lanes>(omc: W, opc: W) -> W {
+fn ln_half<W: Lanes>(p: W, q: W) -> W {
     let (one, half) = (W::splat(1.0), W::splat(0.5));
-    let small = omc.lt(opc);
-    let x = W::splat(-0.5) * omc;
-    let u = x + one;
-    let l = ln_full(small.select(u, half * opc));
-    let log1p = u.eq(one).select(x, x * (l / (u - one)));
-    half * small.select(log1p, l)
+    let near = p.lt(q);
+    let x = W::splat(-0.5) * p;
+    let u = one + x;
+    let l = ln_full(near.select(u, half * q));
+    let l1p = u.eq(one).select(x, l * (x / (u - one)));
+    half * near.select(l1p, l)
 }
 
 /// The scalar `exponent_coord`.
@@ -180,15 +194,12 @@ fn exponent_coord<W: Lanes>(e: W) -> W {
 #[inline(always)]
 fn baseline<W: Lanes>(e1: W, e2: W, c: W, s: W) -> Baseline<W> {
     let (zero, one, half) = (W::splat(0.0), W::splat(1.0), W::splat(0.5));
-    let two_pi = W::splat(TAU);
-    // The peak of the product (exponents e1, e2), for e1 + e2 > 0.
-    let (r, omr2) = ratio(e1, e2);
-    let cy = (c * c + omr2 * s * s).sqrt();
-    let (sn1, cs1) = peak_pair(s, c, r, omr2, cy);
-    let (sn2, cs2) = peak_pair(s, c, -r, omr2, cy);
-    let (omc1, opc1) = one_pm_cos(sn1, cs1);
-    let (omc2, opc2) = one_pm_cos(sn2, cs2);
-    let term = |e: W, omc: W, opc: W| e.eq(zero).select(zero, e * ln_cos_half(omc, opc));
+    // The peak of the product (exponents e1, e2), for e1 + e2 > 0: lanes 2 and 3 of the
+    // scalar kernel's arcs.
+    let r = e2 - e1;
+    let (_, _, omc1, opc1) = arc(e1, e2, r, c, c, s);
+    let (_, _, omc2, opc2) = arc(e1, e2, -r, c, c, s);
+    let term = |e: W, omc: W, opc: W| e.eq(zero).select(zero, e * ln_half(omc, opc));
     let curv = |e: W, opc: W| e.eq(zero).select(zero, e * W::splat(2.0) / opc);
     let peak_ln = term(e1, omc1, opc1) + term(e2, omc2, opc2);
     let peak_curv = curv(e1, opc1) + curv(e2, opc2);
@@ -202,49 +213,38 @@ fn baseline<W: Lanes>(e1: W, e2: W, c: W, s: W) -> Baseline<W> {
     let ln_peak = lune.select(peak_ln, zero);
     let arc_curvature = lune.select(peak_curv, e1 + e2);
 
-    // Laplace in the logit variable around the peak of sin^(e1+1)·sin^(e2+1).
+    // Laplace in the logit variable around the peak of sin^(e1+1)·sin^(e2+1): lanes 0 and
+    // 1 of the arcs (their sines times f1 + f2).
     let (f1, f2) = (e1 + one, e2 + one);
-    let (r, omr2) = ratio(f1, f2);
-    let cy = (c * c + omr2 * s * s).sqrt();
-    let (snx, csx) = peak_pair(s, -c, -r, omr2, cy);
-    let (sny, csy) = peak_pair(s, -c, r, omr2, cy);
+    let r = f2 - f1;
+    let (snx, csx, omcx, opcx) = arc(f1, f2, -r, -c, c, s);
+    let (sny, csy, omcy, opcy) = arc(f1, f2, r, -c, c, s);
     // Lanes near α = π go to the scalar kernel (see `MIN_WIDE_SIN`).
-    let redo = !(snx.ge(W::splat(MIN_WIDE_SIN)) & sny.ge(W::splat(MIN_WIDE_SIN)));
+    let min_sn = W::splat(MIN_WIDE_SIN) * (f1 + f2);
+    let redo = !(snx.ge(min_sn) & sny.ge(min_sn));
     let x = half * snx.atan2(csx);
     let y = half * sny.atan2(csy);
-    let (omcx, opcx) = one_pm_cos(snx, csx);
-    let (omcy, opcy) = one_pm_cos(sny, csy);
-    let ln_sin_x = ln_cos_half(opcx, omcx);
-    let ln_sin_y = ln_cos_half(opcy, omcy);
+    let ln_sin_x = ln_half(opcx, omcx);
+    let ln_sin_y = ln_half(opcy, omcy);
     let w = clamp(
         -(f1 * ln_sin_x + f2 * ln_sin_y) * W::splat(1.0 / ANGLE_LOG_DROP),
         zero,
         one,
     )
     .sqrt();
-    let l = x + y;
-    let (ix, iy, il) = (one / x, one / y, one / l);
-    let (iox, ioy) = (one / omcx, one / omcy);
-    let m = x * y * il;
-    let cot_x = (opcx * iox).sqrt();
-    let cot_y = (opcy * ioy).sqrt();
-    let a = e1 * cot_x + ix;
-    let b = e2 * cot_y + iy;
-    let d = a - b;
-    let phi1 = d * m;
-    let ap = e1 * W::splat(2.0) * iox + ix * ix;
-    let bp = e2 * W::splat(2.0) * ioy + iy * iy;
-    let h = max_num(m * m * (ap + bp) - d * (y - x) * m * il, W::splat(1e-30));
-    // The scalar kernel's one logarithm for ln K + ln m + ½·ln(2π/h) and its shared
-    // reciprocal; lanes where it takes its three-logarithm branch go to the scalar kernel.
+    let (ix, iy) = (one / x, one / y);
+    let (cot2x, cot2y) = (opcx / omcx, opcy / omcy);
+    let (csc2x, csc2y) = (W::splat(2.0) / omcx, W::splat(2.0) / omcy);
+    let d = (e1 * cot2x.sqrt() + ix) - (e2 * cot2y.sqrt() + iy);
+    let ap = e1 * csc2x + ix * ix;
+    let bp = e2 * csc2y + iy * iy;
+    let hq = max_num(ap + bp - d * (y - x) * (ix * iy), W::splat(1e-30));
+    // The scalar kernel answers ln B = −∞ where hq overflows.
+    let redo = redo | hq.eq(W::splat(f32::INFINITY));
     let n15 = e1 + e2 + W::splat(1.5);
-    let inv = one / (n15 * h);
-    let tm = two_pi * m;
-    let q = tm * tm * inv;
-    let big = W::splat(f32::MAX);
-    let redo = redo | !(q.ge(W::splat(f32::MIN_POSITIVE)) & q.le(big) & inv.le(big));
-    let quad = phi1 * phi1 * (half * n15) * inv;
-    let ln_b = e1 * ln_sin_x + e2 * ln_sin_y + half * ln_full(q) + quad;
+    let logs = W::splat(LN_TAU) - half * (ln_full(n15) + ln_full(hq));
+    let quad = half * d * (d / hq);
+    let ln_b = e1 * ln_sin_x + e2 * ln_sin_y + logs + quad;
     Baseline {
         ln_b,
         w,
