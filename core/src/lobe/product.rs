@@ -186,11 +186,18 @@ impl<'a> ProductTable<'a> {
         let (i, fi) = cell(u1, self.exponents);
         let (j, fj) = cell(u2, self.exponents);
         let (k, fk) = cell(w, self.angles);
+        // Entries k and k + 1 of the row of the exponent pair (a, b) (the table is symmetric
+        // and stores a ≤ b): one bound check for both.
         let at = |a: usize, b: usize| {
-            let (lo, hi) = if a <= b { (a, b) } else { (b, a) };
-            let base = (hi * (hi + 1) / 2 + lo) * self.angles + k;
-            let g0 = self.value(base);
-            let g1 = self.value(base + 1);
+            let (lo, hi) = (a.min(b), a.max(b));
+            let base = 4 * ((hi * (hi + 1) / 2 + lo) * self.angles + k);
+            let (g0, g1) = match self.payload.get(base..base + 8) {
+                Some(v) => (
+                    f32::from_le_bytes([v[0], v[1], v[2], v[3]]),
+                    f32::from_le_bytes([v[4], v[5], v[6], v[7]]),
+                ),
+                None => (0.0, 0.0),
+            };
             g0 + fk * (g1 - g0)
         };
         let g00 = at(i, j);
@@ -413,14 +420,17 @@ pub struct Baseline {
 #[inline(always)]
 fn peak(e1: f32, e2: f32, c: f32, s: f32, arcs: &Arcs) -> ((f32, f32), f32, f32) {
     if e1 + e2 > 0.0 && (e1 + e2).is_finite() {
-        let term = |e: f32, ln: f32| if e == 0.0 { 0.0 } else { e * ln };
-        // sec²t = 2/(1 + cos 2t).
-        let curv = |e: f32, opc: f32| if e == 0.0 { 0.0 } else { e * 2.0 / opc };
+        // e·ln cos t and e·sec²t = 2e/(1 + cos 2t) in lanes 2–3, 0 for e = 0 (whose
+        // logarithm may be −∞): lane selects, not branches (random pairs take both).
+        let e = Vec4::new(0.0, 0.0, e1, e2);
+        let none = e.cmpeq(Vec4::ZERO);
+        let term = Vec4::select(none, Vec4::ZERO, e * arcs.ln);
+        let curv = Vec4::select(none, Vec4::ZERO, e * 2.0 / arcs.opc);
         let (opc1, omc1) = (arcs.opc.z, arcs.omc.z);
         (
             (math::sqrtf(0.5 * opc1), math::sqrtf(0.5 * omc1)),
-            term(e1, arcs.ln.z) + term(e2, arcs.ln.w),
-            curv(e1, opc1) + curv(e2, arcs.opc.w),
+            term.z + term.w,
+            curv.z + curv.w,
         )
     } else {
         // Both exponents 0 (a lune: constant on it) or infinite: the bisector.
