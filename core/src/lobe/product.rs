@@ -215,8 +215,10 @@ impl<'a> ProductTable<'a> {
 fn cell(x: f32, n: usize) -> (usize, f32) {
     let last = (n - 1) as f32;
     let t = (x * last).clamp(0.0, last);
-    let i = (t as usize).min(n - 2);
-    (i, t - i as f32)
+    // `as u32`, not `as usize`: the same value (t ∈ [0, n − 1]) in a third of the
+    // instructions of the saturating 64-bit conversion.
+    let i = (t as u32).min(n as u32 - 2);
+    (i as usize, t - i as f32)
 }
 
 /// The table's exponent coordinate `u = ln(1 + e/ε)/ln(1 + E/ε)`, clamped to `[0, 1]`
@@ -398,6 +400,25 @@ fn atan2_pos(y: Vec4, x: Vec4) -> Vec4 {
     Vec4::select(y.is_nan_mask() | x.is_nan_mask(), Vec4::NAN, r)
 }
 
+/// `e^(−g)` for the table's correction `g`: where `|g| ≤ 1/4` (the built-in table's values
+/// lie in `[0, 0.19]`) its Taylor polynomial of degree 6 (remainder below `g⁷/7! ≤ 1.3e-8`,
+/// a tenth of an ulp; Estrin's scheme), else [`math::exp_x4`]. Within 1 ulp over `[−1/4,
+/// 1/4]` (test `exp_neg_small_against_f64`).
+#[inline(always)]
+fn exp_neg_small(g: f32) -> f32 {
+    if g.abs() <= 0.25 {
+        // 1 − g·q, q = 1 − g/2 + g²/6 − g³/24 + g⁴/120 − g⁵/720: q's rounding reaches the
+        // result times |g| ≤ 1/4.
+        let g2 = g * g;
+        let q = (1.0 - g * 0.5)
+            + g2 * (1.0 / 6.0 - g * (1.0 / 24.0))
+            + (g2 * g2) * (1.0 / 120.0 - g * (1.0 / 720.0));
+        1.0 - g * q
+    } else {
+        math::exp_x4(Vec4::splat(-g)).x
+    }
+}
+
 /// Everything the kernel derives in closed form from `(e1, e2, cos α, sin α)`.
 #[derive(Clone, Copy, Debug)]
 pub struct Baseline {
@@ -443,10 +464,34 @@ fn peak(e1: f32, e2: f32, c: f32, s: f32, arcs: &Arcs) -> ((f32, f32), f32, f32)
     }
 }
 
-/// `ln B` from lanes 0–1 of the arcs (module docs); `None` where the open hemispheres are
-/// disjoint (`α = π`: `ln B = −∞`).
+/// The logit-Laplace baseline in parts: `ln B = ln_sines + quad + ln 2π − ½·ln((n + 1.5)·hq)`
+/// (see [`baseline_parts`]), so that a caller that wants `B` itself takes a square root
+/// where `ln B` takes a logarithm.
+#[derive(Clone, Copy, Debug)]
+struct BaselineParts {
+    /// `e1·ln sin x + e2·ln sin y`.
+    ln_sines: f32,
+    /// `φ'²/(−2φ'') ≥ 0`.
+    quad: f32,
+    /// `n + 1.5 = e1 + e2 + 1.5`.
+    n15: f32,
+    /// `−φ''/m²`, floored at `1e-30`.
+    hq: f32,
+}
+
+impl BaselineParts {
+    /// `ln B`.
+    #[inline(always)]
+    fn ln_b(&self) -> f32 {
+        let l = math::ln_x4(Vec4::new(self.n15, self.hq, 1.0, 1.0));
+        self.ln_sines + (LN_TWO_PI - 0.5 * (l.x + l.y)) + self.quad
+    }
+}
+
+/// The parts of `ln B` from lanes 0–1 of the arcs (module docs); `None` where the open
+/// hemispheres are disjoint (`α = π`: `ln B = −∞`).
 #[inline(always)]
-fn ln_baseline(e1: f32, e2: f32, arcs: &Arcs) -> Option<f32> {
+fn baseline_parts(e1: f32, e2: f32, arcs: &Arcs) -> Option<BaselineParts> {
     let angles = 0.5 * atan2_pos(arcs.sn, arcs.cs);
     let (x, y) = (angles.x, angles.y);
     if !(x > 0.0 && y > 0.0) {
@@ -473,11 +518,13 @@ fn ln_baseline(e1: f32, e2: f32, arcs: &Arcs) -> Option<f32> {
     if hq == f32::INFINITY {
         return None;
     }
-    let n15 = e1 + e2 + 1.5;
-    let ln2 = math::ln_x4(Vec4::new(n15, hq, 1.0, 1.0));
-    let logs = LN_TWO_PI - 0.5 * (ln2.x + ln2.y);
     let quad = 0.5 * d * (d / hq);
-    Some(e1 * arcs.ln.x + e2 * arcs.ln.y + logs + quad)
+    Some(BaselineParts {
+        ln_sines: e1 * arcs.ln.x + e2 * arcs.ln.y,
+        quad,
+        n15: e1 + e2 + 1.5,
+        hq,
+    })
 }
 
 /// The closed-form part of the product of unit lobes with exponents `e1, e2` (clamped to
@@ -498,7 +545,7 @@ pub fn baseline(e1: f32, e2: f32, cos_a: f32, sin_a: f32) -> Baseline {
     }
     let arcs = arcs(e1, e2, c, s);
     let (peak_dir, ln_peak, arc_curvature) = peak(e1, e2, c, s, &arcs);
-    let ln_b = ln_baseline(e1, e2, &arcs);
+    let ln_b = baseline_parts(e1, e2, &arcs).map(|p| p.ln_b());
     Baseline {
         ln_b: ln_b.unwrap_or(f32::NEG_INFINITY),
         w: if ln_b.is_some() {
@@ -604,17 +651,16 @@ pub fn product_with(
         ProductFit::SphericalGaussian => 0.0,
     };
     let nan = f32::NAN;
-    let ((peak_dir, ln_peak, arc_curvature), ln_b) = if c.is_nan() {
-        (((nan, nan), nan, nan), nan)
+    let ((peak_dir, ln_peak, arc_curvature), parts) = if c.is_nan() {
+        let parts = BaselineParts {
+            ln_sines: nan,
+            quad: nan,
+            n15: nan,
+            hq: nan,
+        };
+        (((nan, nan), nan, nan), Some(parts))
     } else {
-        let ln_b = ln_baseline(e1c, e2c, &arcs).unwrap_or(f32::NEG_INFINITY);
-        (peak(e1c, e2c, c, s, &arcs), ln_b)
-    };
-    let ln_i = match fit {
-        // `baseline` looks the table up at w = 1 where ln B = −∞; the sum is −∞ either way.
-        _ if fit != ProductFit::SphericalGaussian && ln_b == f32::NEG_INFINITY => ln_b,
-        ProductFit::ExactIntegral | ProductFit::ExactIntegralCurvature => ln_b + g,
-        ProductFit::SphericalGaussian => ln_sg_integral(e1, e2, c, s),
+        (peak(e1c, e2c, c, s, &arcs), baseline_parts(e1c, e2c, &arcs))
     };
     let (ct, st) = peak_dir;
     let axis = a.axis() * ct + w * st;
@@ -622,9 +668,6 @@ pub fn product_with(
     if e1.is_nan() || e2.is_nan() {
         // A NaN exponent is not silently taken as 0 (the clamps above would).
         return CosineLobe::saturating(axis, f32::NAN, f32::NAN);
-    }
-    if ln_i == f32::NEG_INFINITY {
-        return CosineLobe::saturating(axis, 0.0 * scale, 0.0);
     }
     // s1·s2·q, without `∞·0` when s1·s2 overflows but the product does not.
     let times_scale = |q: f32| {
@@ -634,22 +677,54 @@ pub fn product_with(
             a.scale() * (b.scale() * q)
         }
     };
-    if fit == ProductFit::ExactIntegralCurvature {
-        let e_r = math::sqrtf((e1c + e2c) * arc_curvature);
-        // A peak on an e < 1 lobe's horizon has no curvature to match (the lobe has a
-        // kink there): the peak-matched exponent below takes over.
-        if e_r.is_finite() {
+    // No baseline (α = π, or `hq` overflowed: `ln B = −∞`): a zero-scale lobe.
+    let zero = CosineLobe::saturating(axis, 0.0 * scale, 0.0);
+    // 2π·peak/(e_r + 1) = I, and the peak: both exponentials in one call.
+    let peak_matched = |ln_i: f32| {
+        let ex = math::exp_x4(Vec4::new(LN_TWO_PI + ln_peak - ln_i, ln_peak, 0.0, 0.0));
+        CosineLobe::saturating(axis, times_scale(ex.y), (ex.x - 1.0).max(0.0))
+    };
+    match (fit, parts) {
+        (ProductFit::SphericalGaussian, _) => {
+            let ln_i = ln_sg_integral(e1, e2, c, s);
+            if ln_i == f32::NEG_INFINITY {
+                return zero;
+            }
+            peak_matched(ln_i)
+        }
+        (_, None) => zero,
+        (ProductFit::ExactIntegral, Some(p)) => {
+            // 2π·peak/(e_r + 1) = I = B·e^g with B = e^(ln_sines + quad)·2π/√((n + 1.5)·hq):
+            // e_r + 1 = e^(ln p − ln_sines)·√(n + 1.5)·√hq·e^(−(quad + g)). The first
+            // exponential needs only the arcs, so it is computed while the rest of the
+            // baseline and the table are; a root replaces `ln B`'s logarithm; `quad + g` is
+            // small (the table's g ∈ [0, 0.19], quad below 0.01 on random pairs), its
+            // exponential a polynomial. Where the first exponent leaves [−80, 80] (or is
+            // NaN) the whole `ln I` takes over.
+            let arg = ln_peak - p.ln_sines;
+            if arg.is_nan() || arg.abs() >= 80.0 {
+                return peak_matched(p.ln_b() + g);
+            }
+            let ex = math::exp_x4(Vec4::new(arg, ln_peak, 0.0, 0.0));
+            let roots = Vec4::new(p.n15, p.hq, 0.0, 0.0).sqrt();
+            let e_r = ex.x * (roots.x * roots.y) * exp_neg_small(p.quad + g) - 1.0;
+            CosineLobe::saturating(axis, times_scale(ex.y), e_r.max(0.0))
+        }
+        (ProductFit::ExactIntegralCurvature, Some(p)) => {
+            let ln_i = p.ln_b() + g;
+            let e_r = math::sqrtf((e1c + e2c) * arc_curvature);
+            // A peak on an e < 1 lobe's horizon has no curvature to match (the lobe has a
+            // kink there): the peak-matched exponent takes over.
+            if !e_r.is_finite() {
+                return peak_matched(ln_i);
+            }
             // p·2π/(e_r + 1) = I, with p = exp(ln I + ln((e_r + 1)/2π)) so that a tiny
             // `I` with a large `e_r` does not lose `p` to underflow.
             let p = ln_i + math::logf((e_r + 1.0) * (1.0 / TWO_PI));
             let q = math::exp_x4(Vec4::splat(p)).x;
-            return CosineLobe::saturating(axis, times_scale(q), e_r);
+            CosineLobe::saturating(axis, times_scale(q), e_r)
         }
     }
-    // 2π·peak/(e_r + 1) = I, and the peak: both exponentials in one call.
-    let ex = math::exp_x4(Vec4::new(LN_TWO_PI + ln_peak - ln_i, ln_peak, 0.0, 0.0));
-    let e_r = ex.x - 1.0;
-    CosineLobe::saturating(axis, times_scale(ex.y), e_r.max(0.0))
 }
 
 #[cfg(test)]
@@ -731,5 +806,22 @@ mod tests {
             }
             t *= 1.01;
         }
+    }
+
+    /// `exp_neg_small` within 1 ulp of the `f64` `e^(−g)` on a fine grid over `[−1/4, 1/4]`
+    /// (its polynomial) and beyond (its fallback), NaN for NaN.
+    #[test]
+    fn exp_neg_small_against_f64() {
+        let mut worst = 0.0f64;
+        let mut g = -1.0f32;
+        while g <= 1.0 {
+            let want = (-(g as f64)).exp();
+            let w = want as f32;
+            let ulp = (f32::from_bits(w.to_bits() + 1) - w) as f64;
+            worst = worst.max((exp_neg_small(g) as f64 - want).abs() / ulp);
+            g += 1.0 / 65536.0;
+        }
+        assert!(worst <= 1.0, "{worst}");
+        assert!(exp_neg_small(f32::NAN).is_nan());
     }
 }
