@@ -11,7 +11,6 @@
 
 @group(0) @binding(3) var<storage, read> table: array<f32>;
 
-const TWO_PI: f32 = 6.2831855;
 // ln(2*pi) as the f32 the scalar kernel computes.
 const LN_TWO_PI: f32 = 1.837877;
 // `product::EXPONENT_EPS`, `1/ln(1 + E/eps)`, `product::ANGLE_LOG_DROP`.
@@ -32,23 +31,56 @@ fn one_pm_cos(sn: f32, cs: f32) -> vec2<f32> {
     return vec2<f32>((h - cs) / h, s2 / (h - cs));
 }
 
-// (sin, cos) of 2t* for the peak of cos^f1(t)·cos^f2(α − t), t from axis 1.
-fn peak_pair(s: f32, c: f32, r: f32, omr2: f32, cy: f32) -> vec2<f32> {
-    let rc = -r * c;
-    var sn: f32;
-    if (rc >= 0.0) {
-        let den = cy + rc;
-        sn = select(0.0, s * omr2 / den, den > 0.0);
-    } else {
-        sn = s * (cy - rc);
+// A power of two k that brings k·n into [2^-20, 2^20] (the scalar `pow2_range`).
+fn pow2_range(n: f32) -> f32 {
+    if (n < 9.5367431640625e-7) {
+        return select(1.8446744073709552e19, 1.2676506002282294e30, n < 8.673617379884035e-19);
     }
-    return vec2<f32>(sn, c * cy - r * s * s);
+    if (n > 1048576.0) {
+        return select(9.094947017729282e-13, 7.888609052210118e-31, n > 1.152921504606847e18);
+    }
+    return 1.0;
 }
 
-// (r, 1 − r²) for exponents f1, f2 >= 0, f1 + f2 > 0.
-fn ratio(f1: f32, f2: f32) -> vec2<f32> {
-    let n = f1 + f2;
-    return vec2<f32>((f2 - f1) / n, 4.0 * (f1 / n) * (f2 / n));
+// One lane of the scalar kernel's `arcs`: the doubled angle from an axis (c4 = c) or a
+// horizon (c4 = −c) to the peak for exponents (a0, b0), r = sign·(b − a), everything
+// times n = a + b (prescaled by pow2_range); returns (sn, cs, 1 − cos, 1 + cos).
+fn arc(a0: f32, b0: f32, sign: f32, c4: f32, c: f32, s: f32) -> vec4<f32> {
+    let k = pow2_range(a0 + b0);
+    let a = a0 * k;
+    let b = b0 * k;
+    let n = a + b;
+    let r = (b - a) * sign;
+    let ab4 = 4.0 * a * b;
+    let cy = sqrt(n * n * (c * c) + ab4 * (s * s));
+    let rc = -r * c4;
+    let den = cy + rc;
+    let pos = select(0.0, s * ab4 / den, den > 0.0);
+    let sn = select(s * (cy - rc), pos, rc >= 0.0);
+    let cs = c4 * cy - r * s * s;
+    // |(sn, cs)| = n·(c² + s²).
+    let h = n * (c * c + s * s);
+    if (h == 0.0) {
+        return vec4<f32>(sn, cs, 1.0, 1.0);
+    }
+    let d = h + abs(cs);
+    let small = sn * sn / (h * d);
+    let big = d / h;
+    if (cs >= 0.0) {
+        return vec4<f32>(sn, cs, small, big);
+    }
+    return vec4<f32>(sn, cs, big, small);
+}
+
+// e^(−g): the scalar `exp_neg_small` (degree-6 Taylor polynomial where |g| <= 1/4).
+fn exp_neg_small(g: f32) -> f32 {
+    if (abs(g) <= 0.25) {
+        let g2 = g * g;
+        let q = (1.0 - g * 0.5) + g2 * (1.0 / 6.0 - g * (1.0 / 24.0))
+            + (g2 * g2) * (1.0 / 120.0 - g * (1.0 / 720.0));
+        return 1.0 - g * q;
+    }
+    return exp(-g);
 }
 
 // ln cos t from (1 − cos 2t, 1 + cos 2t).
@@ -149,25 +181,22 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     let c = clamp(c0, -1.0, 1.0);
     let s = min(s0, 1.0);
 
-    // The product's peak: direction (cos t*, sin t*) from a1 and ln of its value.
+    // The product's peak: direction (cos t*, sin t*) from a1 and ln of its value (lanes 2
+    // and 3 of the scalar kernel's arcs).
     var ct: f32;
     var st: f32;
     var ln_peak = 0.0;
     if (e1 + e2 > 0.0) {
-        let rr = ratio(e1, e2);
-        let cy = sqrt(c * c + rr.y * s * s);
-        let p1 = peak_pair(s, c, rr.x, rr.y, cy);
-        let p2 = peak_pair(s, c, -rr.x, rr.y, cy);
-        let q1 = one_pm_cos(p1.x, p1.y);
-        let q2 = one_pm_cos(p2.x, p2.y);
+        let p1 = arc(e1, e2, 1.0, c, c, s);
+        let p2 = arc(e1, e2, -1.0, c, c, s);
         if (e1 != 0.0) {
-            ln_peak = ln_peak + e1 * ln_cos_half(q1.x, q1.y);
+            ln_peak = ln_peak + e1 * ln_cos_half(p1.z, p1.w);
         }
         if (e2 != 0.0) {
-            ln_peak = ln_peak + e2 * ln_cos_half(q2.x, q2.y);
+            ln_peak = ln_peak + e2 * ln_cos_half(p2.z, p2.w);
         }
-        ct = sqrt(0.5 * q1.y);
-        st = sqrt(0.5 * q1.x);
+        ct = sqrt(0.5 * p1.w);
+        st = sqrt(0.5 * p1.z);
     } else {
         let q = one_pm_cos(s, c);
         ct = sqrt(0.5 * q.y);
@@ -175,13 +204,12 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     }
     let axis = normalize_axis(a1 * ct + w * st);
 
-    // Laplace in the logit variable around the peak of sin^(e1+1)·sin^(e2+1).
+    // Laplace in the logit variable around the peak of sin^(e1+1)·sin^(e2+1) (lanes 0 and
+    // 1 of the arcs).
     let f1 = e1 + 1.0;
     let f2 = e2 + 1.0;
-    let rr = ratio(f1, f2);
-    let cy = sqrt(c * c + rr.y * s * s);
-    let px = peak_pair(s, -c, -rr.x, rr.y, cy);
-    let py = peak_pair(s, -c, rr.x, rr.y, cy);
+    let px = arc(f1, f2, -1.0, -c, c, s);
+    let py = arc(f1, f2, 1.0, -c, c, s);
     let x = 0.5 * atan2_(px.x, px.y);
     let y = 0.5 * atan2_(py.x, py.y);
     if (!(x > 0.0 && y > 0.0)) {
@@ -189,47 +217,36 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
         write_row(i, n, axis, 0.0 * scale, 0.0);
         return;
     }
-    let qx = one_pm_cos(px.x, px.y);
-    let qy = one_pm_cos(py.x, py.y);
-    let ln_sin_x = ln_cos_half(qx.y, qx.x);
-    let ln_sin_y = ln_cos_half(qy.y, qy.x);
+    let ln_sin_x = ln_cos_half(px.w, px.z);
+    let ln_sin_y = ln_cos_half(py.w, py.z);
     let wc = sqrt(clamp(-(f1 * ln_sin_x + f2 * ln_sin_y) * (1.0 / ANGLE_LOG_DROP), 0.0, 1.0));
     // The table's loads first, so that they overlap the rest of the baseline.
     let g = correction(exponent_coord(e1), exponent_coord(e2), wc);
-    let l = x + y;
     let ix = 1.0 / x;
     let iy = 1.0 / y;
-    let il = 1.0 / l;
-    let iox = 1.0 / qx.x;
-    let ioy = 1.0 / qy.x;
-    let m = x * y * il;
-    let cot_x = sqrt(qx.y * iox);
-    let cot_y = sqrt(qy.y * ioy);
-    let a = e1 * cot_x + ix;
-    let b = e2 * cot_y + iy;
-    let d = a - b;
-    let phi1 = d * m;
-    let ap = e1 * 2.0 * iox + ix * ix;
-    let bp = e2 * 2.0 * ioy + iy * iy;
-    let h = max(m * m * (ap + bp) - d * (y - x) * m * il, 1e-30);
-    // ln K + ln m + ½·ln(2π/h) = ½·ln((2π·m)²/((n + 1.5)·h)): one logarithm where that
-    // argument is a normal number (the scalar kernel's choice), three elsewhere.
-    let n15 = e1 + e2 + 1.5;
-    let inv = 1.0 / (n15 * h);
-    let q = (TWO_PI * m) * (TWO_PI * m) * inv;
-    var logs: f32;
-    var quad: f32;
-    if (q >= 1.1754944e-38 && q <= 3.4028235e38 && inv <= 3.4028235e38) {
-        logs = 0.5 * ln_(q);
-        quad = phi1 * phi1 * (0.5 * n15) * inv;
-    } else {
-        logs = 0.5 * ln_(TWO_PI / n15) + ln_(m) + 0.5 * ln_(TWO_PI / h);
-        quad = phi1 * phi1 / (2.0 * h);
+    let cot_x = sqrt(px.w / px.z);
+    let cot_y = sqrt(py.w / py.z);
+    let d = (e1 * cot_x + ix) - (e2 * cot_y + iy);
+    let ap = e1 * (2.0 / px.z) + ix * ix;
+    let bp = e2 * (2.0 / py.z) + iy * iy;
+    // −φ''/m² (the scalar kernel's hq); ln B = ln_sines + ln 2π − ½·ln((n + 1.5)·hq) + quad.
+    let hq = max(ap + bp - d * (y - x) * (ix * iy), 1e-30);
+    if (hq > 3.4028235e38) {
+        write_row(i, n, axis, 0.0 * scale, 0.0);
+        return;
     }
-    let ln_b = e1 * ln_sin_x + e2 * ln_sin_y + logs + quad;
-    let ln_i = ln_b + g;
-
-    // 2π·peak/(e_r + 1) = I.
-    let e_r = exp(LN_TWO_PI + ln_peak - ln_i) - 1.0;
+    let quad = 0.5 * d * (d / hq);
+    let n15 = e1 + e2 + 1.5;
+    let ln_sines = e1 * ln_sin_x + e2 * ln_sin_y;
+    // 2π·peak/(e_r + 1) = I = B·e^g: e_r + 1 = e^(ln p − ln_sines)·√(n + 1.5)·√hq·e^(−(quad
+    // + g)), or from ln I whole where that first exponent leaves [−80, 80].
+    let arg = ln_peak - ln_sines;
+    var e_r: f32;
+    if (abs(arg) < 80.0) {
+        e_r = exp(arg) * (sqrt(n15) * sqrt(hq)) * exp_neg_small(quad + g) - 1.0;
+    } else {
+        let ln_b = ln_sines + (LN_TWO_PI - 0.5 * (ln_(n15) + ln_(hq))) + quad;
+        e_r = exp(LN_TWO_PI + ln_peak - (ln_b + g)) - 1.0;
+    }
     write_row(i, n, axis, scale * exp(ln_peak), max(e_r, 0.0));
 }

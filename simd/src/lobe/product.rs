@@ -241,12 +241,11 @@ fn baseline<W: Lanes>(e1: W, e2: W, c: W, s: W) -> Baseline<W> {
     let hq = max_num(ap + bp - d * (y - x) * (ix * iy), W::splat(1e-30));
     // The scalar kernel answers ln B = −∞ where hq overflows.
     let redo = redo | hq.eq(W::splat(f32::INFINITY));
-    let n15 = e1 + e2 + W::splat(1.5);
-    let logs = W::splat(LN_TAU) - half * (ln_full(n15) + ln_full(hq));
-    let quad = half * d * (d / hq);
-    let ln_b = e1 * ln_sin_x + e2 * ln_sin_y + logs + quad;
     Baseline {
-        ln_b,
+        ln_sines: e1 * ln_sin_x + e2 * ln_sin_y,
+        quad: half * d * (d / hq),
+        n15: e1 + e2 + W::splat(1.5),
+        hq,
         w,
         peak_dir,
         ln_peak,
@@ -255,14 +254,45 @@ fn baseline<W: Lanes>(e1: W, e2: W, c: W, s: W) -> Baseline<W> {
     }
 }
 
+/// The scalar `BaselineParts` and the rest of the closed form.
 struct Baseline<W> {
-    ln_b: W,
+    ln_sines: W,
+    quad: W,
+    n15: W,
+    hq: W,
     w: W,
     peak_dir: (W, W),
     ln_peak: W,
     arc_curvature: W,
     /// Lanes to recompute with the scalar kernel.
     redo: W,
+}
+
+impl<W: Lanes> Baseline<W> {
+    /// The scalar `BaselineParts::ln_b`.
+    #[inline(always)]
+    fn ln_b(&self) -> W {
+        let logs = W::splat(LN_TAU) - W::splat(0.5) * (ln_full(self.n15) + ln_full(self.hq));
+        self.ln_sines + logs + self.quad
+    }
+}
+
+/// The scalar `exp_neg_small`: `e^(−g)` by its degree-6 Taylor polynomial where `|g| ≤
+/// 1/4`, wide's `exp` on the other lanes (computed only when some lane needs it).
+#[inline(always)]
+fn exp_neg_small<W: Lanes>(g: W) -> W {
+    let one = W::splat(1.0);
+    let g2 = g * g;
+    let q = (one - g * W::splat(0.5))
+        + g2 * (W::splat(1.0 / 6.0) - g * W::splat(1.0 / 24.0))
+        + (g2 * g2) * (W::splat(1.0 / 120.0) - g * W::splat(1.0 / 720.0));
+    let poly = one - g * q;
+    let far = !g.abs().le(W::splat(0.25));
+    if far.any() {
+        far.select((-g).exp(), poly)
+    } else {
+        poly
+    }
 }
 
 /// The scalar `ln_sg_integral`.
@@ -306,7 +336,7 @@ fn correction<W: Lanes>(table: &ProductTable<'_>, u1: W, u2: W, w: W) -> W {
     for lane in 0..W::N {
         let (i, j, k) = (il[lane], jl[lane], kl[lane]);
         let base = |a: usize, b: usize| {
-            let (lo, hi) = if a <= b { (a, b) } else { (b, a) };
+            let (lo, hi) = (a.min(b), a.max(b));
             (hi * (hi + 1) / 2 + lo) * na + k
         };
         for (c, (a, b)) in [(i, j), (i, j + 1), (i + 1, j), (i + 1, j + 1)]
@@ -389,30 +419,45 @@ fn product_lanes<W: Lanes>(
     let s = min_num(s, one);
 
     let base = baseline(e1, e2, c, s);
-    let ln_i = match fit {
+    let g = match fit {
         ProductFit::ExactIntegral | ProductFit::ExactIntegralCurvature => {
-            base.ln_b + correction(table, exponent_coord(e1), exponent_coord(e2), base.w)
+            correction(table, exponent_coord(e1), exponent_coord(e2), base.w)
         }
-        ProductFit::SphericalGaussian => ln_sg_integral(e1, e2, c, s),
+        ProductFit::SphericalGaussian => zero,
     };
     let (ct, st) = base.peak_dir;
     let (ax, ay, az) = normalize(a1x * ct + wx * st, a1y * ct + wy * st, a1z * ct + wz * st);
     let scale = s1 * s2;
     // s1·s2 overflowing (the scalar kernel then multiplies in another order).
     let redo_in = redo_in | (scale * zero).is_nan();
-    let (out_scale, e_r, redo_in) = if fit == ProductFit::ExactIntegralCurvature {
-        let e_r = ((e1 + e2) * base.arc_curvature).sqrt();
-        let p = exp_gradual(ln_i + ln_full((e_r + one) * W::splat(1.0 / TAU)));
-        // An infinite curvature (peak on an e < 1 lobe's horizon): the scalar kernel
-        // falls back to the peak-matched exponent.
-        (scale * p, e_r, redo_in | (e_r * zero).is_nan())
-    } else {
-        let e_r = (W::splat(LN_TAU) + base.ln_peak - ln_i).exp() - one;
-        (
-            scale * exp_gradual(base.ln_peak),
-            max_num(e_r, zero),
-            redo_in,
-        )
+    // As the scalar kernel: the peak-matched exponent from ln I whole for the curvature
+    // (its fallback) and spherical-Gaussian fits; for the exact-integral fit
+    // e_r + 1 = e^(ln p − ln_sines)·√(n + 1.5)·√hq·e^(−(quad + g)), lanes whose first
+    // exponent leaves [−80, 80] to the scalar kernel.
+    let (out_scale, e_r, redo_in, ln_i) = match fit {
+        ProductFit::ExactIntegralCurvature => {
+            let ln_i = base.ln_b() + g;
+            let e_r = ((e1 + e2) * base.arc_curvature).sqrt();
+            let p = exp_gradual(ln_i + ln_full((e_r + one) * W::splat(1.0 / TAU)));
+            // An infinite curvature (peak on an e < 1 lobe's horizon): the scalar kernel
+            // falls back to the peak-matched exponent.
+            (scale * p, e_r, redo_in | (e_r * zero).is_nan(), ln_i)
+        }
+        ProductFit::SphericalGaussian => {
+            let ln_i = ln_sg_integral(e1, e2, c, s);
+            let e_r = (W::splat(LN_TAU) + base.ln_peak - ln_i).exp() - one;
+            let out = scale * exp_gradual(base.ln_peak);
+            (out, max_num(e_r, zero), redo_in, ln_i)
+        }
+        ProductFit::ExactIntegral => {
+            let arg = base.ln_peak - base.ln_sines;
+            let roots = base.n15.sqrt() * base.hq.sqrt();
+            let e_r = arg.exp() * roots * exp_neg_small(base.quad + g) - one;
+            let out = scale * exp_gradual(base.ln_peak);
+            let redo_in = redo_in | !arg.abs().lt(W::splat(80.0));
+            // ln I = −∞ only on lanes the scalar kernel recomputes (α = π, hq = ∞).
+            (out, max_num(e_r, zero), redo_in, zero)
+        }
     };
     // Scalar: `ln I = −∞` (the baseline's `h` overflowed, or `α = π`, which the scalar
     // fallback handles) gives a zero-scale lobe of exponent 0.
