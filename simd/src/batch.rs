@@ -368,8 +368,9 @@ impl LobeX8 {
     }
 
     /// The eight lobes, rebuilt with [`CosineLobe::saturating`] (which normalises the axis,
-    /// clamps a negative exponent to 0 and keeps NaN). For lobes that came from
-    /// [`CosineLobe`]s this is the identity.
+    /// clamps a negative exponent to 0 and keeps NaN). For lobes built by
+    /// [`CosineLobe::new`] or `saturating` this is the identity; an axis normalised
+    /// otherwise (the lobe product's result) may move by an ulp.
     #[inline]
     pub fn to_array(self) -> [CosineLobe; LANES] {
         let a = self.axis.to_array();

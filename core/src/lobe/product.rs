@@ -575,6 +575,26 @@ fn arc_frame(a1: Vec3, a2: Vec3) -> (f32, f32, Vec3) {
     (c.clamp(-1.0, 1.0), s.min(1.0), w)
 }
 
+/// The result lobe, [`CosineLobe::saturating`] without its general normalisation: the
+/// axis `a1·cos t* + w·sin t*` is a unit vector up to rounding (`a1` and `w` orthonormal,
+/// `(cos t*, sin t*)` a unit pair), so it is divided by its length directly, and
+/// `saturating` (scaled by the largest component first) takes only what leaves `[1/4, 4]`
+/// in squared length, NaN included.
+#[inline(always)]
+fn result_lobe(axis: Vec3, scale: f32, exponent: f32) -> CosineLobe {
+    let l2 = axis.length_squared();
+    if (0.25..=4.0).contains(&l2) {
+        CosineLobe {
+            axis: axis * (1.0 / math::sqrtf(l2)),
+            scale,
+            // `f32::max` would turn NaN into 0.
+            exponent: if exponent < 0.0 { 0.0 } else { exponent },
+        }
+    } else {
+        CosineLobe::saturating(axis, scale, exponent)
+    }
+}
+
 /// Which exponent the result lobe gets. The scale is the product's peak value in both.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
 pub enum ProductFit {
@@ -667,7 +687,7 @@ pub fn product_with(
     let scale = a.scale() * b.scale();
     if e1.is_nan() || e2.is_nan() {
         // A NaN exponent is not silently taken as 0 (the clamps above would).
-        return CosineLobe::saturating(axis, f32::NAN, f32::NAN);
+        return result_lobe(axis, f32::NAN, f32::NAN);
     }
     // s1·s2·q, without `∞·0` when s1·s2 overflows but the product does not.
     let times_scale = |q: f32| {
@@ -678,11 +698,11 @@ pub fn product_with(
         }
     };
     // No baseline (α = π, or `hq` overflowed: `ln B = −∞`): a zero-scale lobe.
-    let zero = CosineLobe::saturating(axis, 0.0 * scale, 0.0);
+    let zero = result_lobe(axis, 0.0 * scale, 0.0);
     // 2π·peak/(e_r + 1) = I, and the peak: both exponentials in one call.
     let peak_matched = |ln_i: f32| {
         let ex = math::exp_x4(Vec4::new(LN_TWO_PI + ln_peak - ln_i, ln_peak, 0.0, 0.0));
-        CosineLobe::saturating(axis, times_scale(ex.y), (ex.x - 1.0).max(0.0))
+        result_lobe(axis, times_scale(ex.y), (ex.x - 1.0).max(0.0))
     };
     match (fit, parts) {
         (ProductFit::SphericalGaussian, _) => {
@@ -708,7 +728,7 @@ pub fn product_with(
             let ex = math::exp_x4(Vec4::new(arg, ln_peak, 0.0, 0.0));
             let roots = Vec4::new(p.n15, p.hq, 0.0, 0.0).sqrt();
             let e_r = ex.x * (roots.x * roots.y) * exp_neg_small(p.quad + g) - 1.0;
-            CosineLobe::saturating(axis, times_scale(ex.y), e_r.max(0.0))
+            result_lobe(axis, times_scale(ex.y), e_r.max(0.0))
         }
         (ProductFit::ExactIntegralCurvature, Some(p)) => {
             let ln_i = p.ln_b() + g;
@@ -722,7 +742,7 @@ pub fn product_with(
             // `I` with a large `e_r` does not lose `p` to underflow.
             let p = ln_i + math::logf((e_r + 1.0) * (1.0 / TWO_PI));
             let q = math::exp_x4(Vec4::splat(p)).x;
-            CosineLobe::saturating(axis, times_scale(q), e_r)
+            result_lobe(axis, times_scale(q), e_r)
         }
     }
 }

@@ -139,8 +139,13 @@ fn write_row(i: u32, n: u32, axis: vec3<f32>, scale: f32, exponent: f32) {
     output[4u * n + i] = exponent;
 }
 
-// `frame::normalize_or_zero`, zero → +z (`CosineLobe::saturating`).
+// The scalar `result_lobe`'s axis: divided by its length where its squared length is in
+// [1/4, 4], else `frame::normalize_or_zero`, zero → +z (`CosineLobe::saturating`).
 fn normalize_axis(v: vec3<f32>) -> vec3<f32> {
+    let l2 = v.x * v.x + v.y * v.y + v.z * v.z;
+    if (l2 >= 0.25 && l2 <= 4.0) {
+        return v * (1.0 / sqrt(l2));
+    }
     let m = max(max(abs(v.x), abs(v.y)), abs(v.z));
     if (m == 0.0) {
         return vec3<f32>(0.0, 0.0, 1.0);

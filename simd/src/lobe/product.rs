@@ -377,6 +377,21 @@ fn normalize<W: Lanes>(x: W, y: W, z: W) -> (W, W, W) {
     )
 }
 
+/// The scalar `result_lobe`'s axis: divided by its length where its squared length is in
+/// `[1/4, 4]`, [`normalize`] (as `CosineLobe::saturating`) elsewhere.
+#[inline(always)]
+fn normalize_result<W: Lanes>(x: W, y: W, z: W) -> (W, W, W) {
+    let l2 = x * x + y * y + z * z;
+    let inv = W::splat(1.0) / l2.sqrt();
+    let near = l2.ge(W::splat(0.25)) & l2.le(W::splat(4.0));
+    let (gx, gy, gz) = normalize(x, y, z);
+    (
+        near.select(x * inv, gx),
+        near.select(y * inv, gy),
+        near.select(z * inv, gz),
+    )
+}
+
 /// The product lane-wise, outputs `[ax, ay, az, scale, exponent]`, and the mask of lanes
 /// to recompute with the scalar kernel.
 #[inline(always)]
@@ -426,7 +441,7 @@ fn product_lanes<W: Lanes>(
         ProductFit::SphericalGaussian => zero,
     };
     let (ct, st) = base.peak_dir;
-    let (ax, ay, az) = normalize(a1x * ct + wx * st, a1y * ct + wy * st, a1z * ct + wz * st);
+    let (ax, ay, az) = normalize_result(a1x * ct + wx * st, a1y * ct + wy * st, a1z * ct + wz * st);
     let scale = s1 * s2;
     // s1·s2 overflowing (the scalar kernel then multiplies in another order).
     let redo_in = redo_in | (scale * zero).is_nan();
