@@ -89,60 +89,78 @@ fn function(n: usize, lanes: bool, out: &mut String) {
             w(out, format!("let i{l} = i{} * inv;", l - 1));
         }
     }
-    for m in 0..n {
-        // The order's angular factors and the chain's first value (`fill`'s first loop;
-        // `Π_m^m` does not depend on the direction: a scalar constant).
-        if m == 0 {
-            let y00 = if lanes { "sp(Y00_F64)" } else { "Y00_F64" };
-            w(out, format!("let q0_0 = {y00};"));
-        } else {
-            let prev = if m == 1 {
-                "Y00_F64".to_string()
+    // One value: the chain's next q (from the order's first value, the one-step start or
+    // the two-term recurrence) and its outputs.
+    let value = |out: &mut String, l: usize, m: usize| {
+        if l == m {
+            // The order's angular factors and the chain's first value (`fill`'s first
+            // loop; `Π_m^m` does not depend on the direction: a scalar constant).
+            if m == 0 {
+                let y00 = if lanes { "sp(Y00_F64)" } else { "Y00_F64" };
+                w(out, format!("let q0_0 = {y00};"));
             } else {
-                format!("p{}", m - 1)
-            };
-            let (c, s) = if m == 1 {
-                (k(1.0), k(0.0))
-            } else {
-                (format!("c{}", m - 1), format!("s{}", m - 1))
-            };
-            w(out, format!("let p{m} = {prev} * {};", lit(DIAG[m])));
-            w(
-                out,
-                format!("let (c{m}, s{m}) = (x * {c} - y * {s}, x * {s} + y * {c});"),
-            );
-            let q = format!("core::f64::consts::SQRT_2 * p{m}");
-            let q = if lanes { format!("sp({q})") } else { q };
-            w(out, format!("let q{m}_{m} = {q};"));
-        }
-        for l in m..n {
-            if l == m + 1 {
-                w(out, format!("let q{l}_{m} = {} * z * q{m}_{m};", k(SUB[m])));
-            } else if l >= m + 2 {
-                let t = tri(l, m);
+                let prev = if m == 1 {
+                    "Y00_F64".to_string()
+                } else {
+                    format!("p{}", m - 1)
+                };
+                let (c, s) = if m == 1 {
+                    (k(1.0), k(0.0))
+                } else {
+                    (format!("c{}", m - 1), format!("s{}", m - 1))
+                };
+                w(out, format!("let p{m} = {prev} * {};", lit(DIAG[m])));
                 w(
                     out,
-                    format!(
-                        "let q{l}_{m} = {} * z * q{}_{m} - {} * r2 * q{}_{m};",
-                        k(A[t]),
-                        l - 1,
-                        k(AB[t]),
-                        l - 2
-                    ),
+                    format!("let (c{m}, s{m}) = (x * {c} - y * {s}, x * {s} + y * {c});"),
                 );
+                let q = format!("core::f64::consts::SQRT_2 * p{m}");
+                let q = if lanes { format!("sp({q})") } else { q };
+                w(out, format!("let q{m}_{m} = {q};"));
             }
-            // The value goes out as q·S_m, then q·C_m; for m = 0 (C = 1, S = 0) that is q
-            // itself (q·1 = q exactly), and coefficient 0 is written once, last.
-            // Each value q·S (q·C) times r^−l last (`fill`'s order: only that product waits
-            // for the normalisation).
-            let at = l * l + l;
-            if m == 0 {
-                if l > 0 {
-                    put(out, at, format!("q{l}_0 * i{l}"));
-                }
-            } else {
-                put(out, at - m, format!("q{l}_{m} * s{m} * i{l}"));
-                put(out, at + m, format!("q{l}_{m} * c{m} * i{l}"));
+        } else if l == m + 1 {
+            w(out, format!("let q{l}_{m} = {} * z * q{m}_{m};", k(SUB[m])));
+        } else {
+            let t = tri(l, m);
+            w(
+                out,
+                format!(
+                    "let q{l}_{m} = {} * z * q{}_{m} - {} * r2 * q{}_{m};",
+                    k(A[t]),
+                    l - 1,
+                    k(AB[t]),
+                    l - 2
+                ),
+            );
+        }
+        // The value goes out as q·S_m, then q·C_m; for m = 0 (C = 1, S = 0) that is q
+        // itself (q·1 = q exactly), and coefficient 0 is written once, last.
+        // Each value q·S (q·C) times r^−l last (`fill`'s order: only that product waits
+        // for the normalisation).
+        let at = l * l + l;
+        if m == 0 {
+            if l > 0 {
+                put(out, at, format!("q{l}_0 * i{l}"));
+            }
+        } else {
+            put(out, at - m, format!("q{l}_{m} * s{m} * i{l}"));
+            put(out, at + m, format!("q{l}_{m} * c{m} * i{l}"));
+        }
+    };
+    // Every value's operations are those of `fill`, whatever the order of the statements:
+    // order by order on lanes; band by band in the scalar code, whose stores then come in
+    // the order of the output (the statement order is what LLVM's SLP vectorizer packs
+    // neighbouring stores from).
+    if lanes {
+        for m in 0..n {
+            for l in m..n {
+                value(out, l, m);
+            }
+        }
+    } else {
+        for l in 0..n {
+            for m in 0..=l {
+                value(out, l, m);
             }
         }
     }
