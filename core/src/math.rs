@@ -1,6 +1,10 @@
 //! The one math shim: every float function the kernels use goes through here, so no other
 //! module needs a `cfg`. With the `std` feature the standard library is used, otherwise (or with
 //! `force-libm`) the `libm` crate. Add a function with one line in the `shim!` list below.
+//!
+//! Below the shim, two functions of four lanes for kernels that take several logarithms or
+//! exponentials side by side ([`ln_x4`], [`exp_x4`], used by the lobe product): polynomial,
+//! branch-free, the same bits with every feature set, each within 1 ulp (tested here).
 
 macro_rules! shim {
     ($( $name:ident ( $t:ty $(, $arg:ident)* ) => $method:ident, $libm:ident ; )*) => {
