@@ -40,8 +40,10 @@
 //! half-angles underflow). So NaN and infinities give exactly what the scalar kernel gives:
 //! scales multiply (a NaN scale gives a NaN scale), a NaN exponent gives a NaN scale and
 //! exponent, a non-finite axis component gives a NaN axis. Lanes whose `s1·s2` overflows,
-//! and curvature-fit lanes whose peak sits on an `e < 1` lobe's horizon, go to the scalar
-//! kernel too. Such lanes are rare in rendering
+//! curvature-fit lanes whose peak sits on an `e < 1` lobe's horizon, and exact-integral
+//! lanes whose baseline overflows (`hq = ∞`) or whose exponent `ln p − ln_sines` leaves
+//! `[−80, 80]` (where the scalar kernel forms `ln I` whole) go to the scalar kernel too.
+//! Such lanes are rare in rendering
 //! (exactly opposite axes are the common one) and cost one scalar call each.
 //!
 //! Table lookups are scalar loads per lane (wide has no gather); the trilinear arithmetic is
