@@ -309,12 +309,11 @@ struct Arcs {
 ///
 /// `(1 ∓ cos φ)` of `φ = atan2(sn, cs)`: with `h = |(sn, cs)|` (`= n·(c² + s²)`, no root)
 /// and `d = h + |cs|`, the larger is `d/h` and the smaller `sn²/(h·d)` (their product is
-/// `sin²φ`). `ln cos θ` from `(1 ∓ cos
-/// 2θ)`: `½·ln((1 + cos 2θ)/2)`, and where `θ` is small `½·ln(1 + x)` with `x = −(1 − cos
-/// 2θ)/2`, as `ln(u)·x/(u − 1)` with `u = 1 + x` rounded (Goldberg 1991, theorem 4: the
-/// rounding of `u` cancels between `ln u` and `u − 1`), `x` itself where `u = 1`, so that
-/// `e·ln cos t*` keeps its relative precision at `e = 1e5`; `ln sin x = ln cos(π/2 − x)`
-/// swaps the pair.
+/// `sin²φ`). `ln cos θ` from `(1 ∓ cos 2θ)`: `½·ln((1 + cos 2θ)/2)`, and where `θ` is
+/// small `½·ln(1 + x)` with `x = −(1 − cos 2θ)/2`, as `ln(u)·x/(u − 1)` with `u = 1 + x`
+/// rounded (Goldberg 1991, theorem 4: the rounding of `u` cancels between `ln u` and
+/// `u − 1`), `x` itself where `u = 1`, so that `e·ln cos t*` keeps its relative precision
+/// at `e = 1e5`; `ln sin x = ln cos(π/2 − x)` swaps the pair.
 #[inline(always)]
 fn arcs(e1: f32, e2: f32, c: f32, s: f32) -> Arcs {
     // Everything times n = f1 + f2 (no division): n·r = f2 − f1 (signed per lane),
@@ -360,8 +359,9 @@ fn arcs(e1: f32, e2: f32, c: f32, s: f32) -> Arcs {
     }
 }
 
-/// A power of two `k` that brings `k·n` (`n ≥ 0`) into `[2⁻²⁰, 2²⁰]` for `n` from the
-/// smallest subnormal to `f32::MAX` (so that `(k·n)²` is normal), `1` where `n` already is.
+/// A power of two `k` (exact to multiply by) with `k·n ∈ [2⁻⁴⁹, 2⁴⁴]` for any `n ≥ 0` from
+/// the smallest subnormal to `f32::MAX`, `1` for `n ∈ [2⁻²⁰, 2²⁰]`: `(k·n)²` and the
+/// products of two such numbers are normal.
 #[inline(always)]
 fn pow2_range(n: Vec4) -> Vec4 {
     let p = |e: i32| Vec4::splat(f32::from_bits(((127 + e) as u32) << 23));

@@ -31,7 +31,8 @@ fn one_pm_cos(sn: f32, cs: f32) -> vec2<f32> {
     return vec2<f32>((h - cs) / h, s2 / (h - cs));
 }
 
-// A power of two k that brings k·n into [2^-20, 2^20] (the scalar `pow2_range`).
+// A power of two k with k·n in [2^-49, 2^44], 1 for n in [2^-20, 2^20] (the scalar
+// `pow2_range`).
 fn pow2_range(n: f32) -> f32 {
     if (n < 9.5367431640625e-7) {
         return select(1.8446744073709552e19, 1.2676506002282294e30, n < 8.673617379884035e-19);

@@ -143,7 +143,7 @@ fn one_pm_cos<W: Lanes>(sn: W, cs: W) -> (W, W) {
 #[inline(always)]
 fn arc<W: Lanes>(a: W, b: W, r: W, c4: W, c: W, s: W) -> (W, W, W, W) {
     let (zero, one) = (W::splat(0.0), W::splat(1.0));
-    // The scalar `pow2_range`: n into [2⁻²⁰, 2²⁰] by an exact power of two.
+    // The scalar `pow2_range`: an exact power of two that keeps n² normal.
     let p = |e: i32| W::splat(f32::from_bits(((127 + e) as u32) << 23));
     let n = a + b;
     let k = n.lt(p(-20)).select(
