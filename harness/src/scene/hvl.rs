@@ -550,7 +550,7 @@ pub fn render_gpu(
         let mut input = Columns::zeros(arity, chunk.len());
         for (r, (_, _, row)) in chunk.iter().enumerate() {
             for (c, v) in row.iter().enumerate() {
-                input.data[c * chunk.len() + r] = *v;
+                input.col_mut(c)[r] = *v;
             }
         }
         let mut out = Columns::zeros(3, chunk.len());
@@ -558,7 +558,7 @@ pub fn render_gpu(
             .map_err(|e| format!("hvl-sum kernel: {e}"))?;
         for (r, (k, albedo, _)) in chunk.iter().enumerate() {
             for (c, (px, a)) in img.data[*k].iter_mut().zip(albedo).enumerate() {
-                *px += f64::from(out.data[c * chunk.len() + r]) * a;
+                *px += f64::from(out.col(c)[r]) * a;
             }
         }
     }
