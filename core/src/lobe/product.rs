@@ -49,11 +49,10 @@
 //! side in the lanes of a `Vec4` (`Arcs`), with one [`math::ln_x4`] for their four
 //! logarithms, and no division before them. The default fit never forms `ln B`:
 //! `e_r + 1 = 2π·p/(B·e^g)` is a product of an exponential that needs only the arcs, two
-//! square roots and a short polynomial in the small `quad + g` (see [`product_with`]).
-//! Criterion `lobe-product/table/scalar`, this kernel and the one before that work built
-//! from deb8f3a^ run in turns on the 2-core development machine: 11.3–11.8 against
-//! 5.1–5.7 M products/s, 2.07–2.22× between adjacent turns, at the same error (the unseen-
-//! points test: mean 6.06e-5, p99 6.06e-4, max 1.69e-3 both before and after).
+//! square roots and a short polynomial in the small `quad + g` (see [`product_with`];
+//! test `quad_and_g_stay_small` checks that they are). Its speed: criterion
+//! `lobe-product/table/scalar` (`cargo bench -p steradian-benches --bench product`) and
+//! the report's `lobe-product` section; its error: the bounds above.
 
 use crate::lobe::CosineLobe;
 use crate::math;
@@ -179,12 +178,16 @@ impl<'a> ProductTable<'a> {
         t
     }
 
-    /// Value `idx` of the packed layout (0 outside, which validation rules out).
+    /// Values `idx` and `idx + 1` of the packed layout, behind one bound check (0 outside,
+    /// which validation rules out): a cell's two angle nodes.
     #[inline(always)]
-    pub fn value(&self, idx: usize) -> f32 {
-        match self.payload.get(4 * idx..4 * idx + 4) {
-            Some(b) => f32::from_le_bytes([b[0], b[1], b[2], b[3]]),
-            None => 0.0,
+    pub fn pair(&self, idx: usize) -> (f32, f32) {
+        match self.payload.get(4 * idx..4 * idx + 8) {
+            Some(v) => (
+                f32::from_le_bytes([v[0], v[1], v[2], v[3]]),
+                f32::from_le_bytes([v[4], v[5], v[6], v[7]]),
+            ),
+            None => (0.0, 0.0),
         }
     }
 
@@ -198,17 +201,10 @@ impl<'a> ProductTable<'a> {
         let (j, fj) = cell(u2, self.exponents);
         let (k, fk) = cell(w, self.angles);
         // Entries k and k + 1 of the row of the exponent pair (a, b) (the table is symmetric
-        // and stores a ≤ b): one bound check for both.
+        // and stores a ≤ b; min/max, not a branch random pairs would mispredict).
         let at = |a: usize, b: usize| {
             let (lo, hi) = (a.min(b), a.max(b));
-            let base = 4 * ((hi * (hi + 1) / 2 + lo) * self.angles + k);
-            let (g0, g1) = match self.payload.get(base..base + 8) {
-                Some(v) => (
-                    f32::from_le_bytes([v[0], v[1], v[2], v[3]]),
-                    f32::from_le_bytes([v[4], v[5], v[6], v[7]]),
-                ),
-                None => (0.0, 0.0),
-            };
+            let (g0, g1) = self.pair((hi * (hi + 1) / 2 + lo) * self.angles + k);
             g0 + fk * (g1 - g0)
         };
         let g00 = at(i, j);
@@ -411,8 +407,9 @@ fn atan2_pos(y: Vec4, x: Vec4) -> Vec4 {
     Vec4::select(y.is_nan_mask() | x.is_nan_mask(), Vec4::NAN, r)
 }
 
-/// `e^(−g)` for the table's correction `g`: where `|g| ≤ 1/4` (the built-in table's values
-/// lie in `[0, 0.19]`) its Taylor polynomial of degree 6 (remainder below `g⁷/7! ≤ 1.3e-8`,
+/// `e^(−g)` for the table's correction `g` (plus the baseline's `quad`): where `|g| ≤ 1/4`
+/// (the built-in table's values lie in `[0, 0.19]`, test `quad_and_g_stay_small`) its
+/// Taylor polynomial of degree 6 (remainder below `g⁷/7! ≤ 1.3e-8`,
 /// a tenth of an ulp; Estrin's scheme), else [`math::exp_x4`]. Within 1 ulp over `[−1/4,
 /// 1/4]` (test `exp_neg_small_against_f64`).
 #[inline(always)]
@@ -709,7 +706,7 @@ pub fn product_with(
         }
     };
     // No baseline (α = π, or `hq` overflowed: `ln B = −∞`): a zero-scale lobe.
-    let zero = result_lobe(axis, 0.0 * scale, 0.0);
+    let zero = || result_lobe(axis, 0.0 * scale, 0.0);
     // 2π·peak/(e_r + 1) = I, and the peak: both exponentials in one call.
     let peak_matched = |ln_i: f32| {
         let ex = math::exp_x4(Vec4::new(LN_TWO_PI + ln_peak - ln_i, ln_peak, 0.0, 0.0));
@@ -719,18 +716,17 @@ pub fn product_with(
         (ProductFit::SphericalGaussian, _) => {
             let ln_i = ln_sg_integral(e1, e2, c, s);
             if ln_i == f32::NEG_INFINITY {
-                return zero;
+                return zero();
             }
             peak_matched(ln_i)
         }
-        (_, None) => zero,
+        (_, None) => zero(),
         (ProductFit::ExactIntegral, Some(p)) => {
             // 2π·peak/(e_r + 1) = I = B·e^g with B = e^(ln_sines + quad)·2π/√((n + 1.5)·hq):
             // e_r + 1 = e^(ln p − ln_sines)·√(n + 1.5)·√hq·e^(−(quad + g)). The first
             // exponential needs only the arcs, so it is computed while the rest of the
             // baseline and the table are; a root replaces `ln B`'s logarithm; `quad + g` is
-            // small (the table's g ∈ [0, 0.19], quad below 0.01 on random pairs), its
-            // exponential a polynomial. Where the first exponent leaves [−80, 80] (or is
+            // small (test `quad_and_g_stay_small`), its exponential a polynomial. Where the first exponent leaves [−80, 80] (or is
             // NaN) the whole `ln I` takes over.
             let arg = ln_peak - p.ln_sines;
             if arg.is_nan() || arg.abs() >= 80.0 {
@@ -854,5 +850,46 @@ mod tests {
         }
         assert!(worst <= 1.0, "{worst}");
         assert!(exp_neg_small(f32::NAN).is_nan());
+    }
+
+    /// What the root form's fast path relies on: every value of the built-in table lies in
+    /// `[0, 0.19]`, and the baseline's `quad` stays below `0.01` over random pairs (the
+    /// criterion bench's distribution: exponents 0 one time in ten, else log-uniform in
+    /// `[1e-3, 1e5]`, angles uniform in `[0, π)`), so `quad + g` takes `exp_neg_small`'s
+    /// polynomial.
+    #[test]
+    fn quad_and_g_stay_small() {
+        let t = ProductTable::builtin();
+        let n = t.bytes() / 4;
+        let (mut lo, mut hi) = (f32::MAX, f32::MIN);
+        for idx in (0..n - 1).step_by(2) {
+            let (a, b) = t.pair(idx);
+            (lo, hi) = (lo.min(a.min(b)), hi.max(a.max(b)));
+        }
+        assert!(lo >= 0.0 && hi <= 0.19, "{lo} {hi}");
+        let mut state = 0x2545_f491_4f6c_dd1du64;
+        let mut unit = || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            (state >> 40) as f32 / (1u64 << 24) as f32
+        };
+        let mut worst = 0.0f32;
+        for _ in 0..100_000 {
+            let mut exponent = || {
+                if unit() < 0.1 {
+                    0.0
+                } else {
+                    1e-3 * math::powf(1e8, unit())
+                }
+            };
+            let (e1, e2) = (exponent(), exponent());
+            let alpha = core::f32::consts::PI * unit();
+            let (c, s) = (math::cosf(alpha), math::sinf(alpha));
+            if let Some(p) = baseline_parts(e1, e2, &arcs(e1, e2, c, s)) {
+                worst = worst.max(p.quad);
+            }
+        }
+        assert!(worst < 0.01, "{worst}");
     }
 }

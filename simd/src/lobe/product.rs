@@ -53,13 +53,9 @@
 //! exponents `{0} ∪ [1e-3, 1e5]` log-uniform, angles uniform in `[0, π)`, scales in
 //! `±[0.1, 10]`; the named cases and arbitrary bit patterns stay within the same bounds):
 //! per unit of `1 + L`, at most `8e-7` for the scale, the exponent and the integral (the
-//! test asserts it; on the development machine 5.5e-7, 4.2e-7 and 5.5e-7, the scale's
-//! largest for `ExactIntegralCurvature`, whose exponent is
-//! bit-identical). **Speed** (criterion `lobe-product/table/simd` against
-//! `lobe-product/table/scalar`, AVX-512 build, 2-core shared machine): 42–48 M products/s
-//! against 11.3–11.8 M/s for the scalar kernel (about 4×). It took the scalar kernel's
-//! division-free arcs, root form of the exponent and branch-free table rows, which moved
-//! it from 36–40 to 42–48 M/s (old and new binaries run in turns).
+//! test asserts it and prints what it measured). **Speed:** criterion
+//! `lobe-product/table/simd` against `lobe-product/table/scalar` (`cargo bench -p
+//! steradian-benches --bench product`), and the report's `lobe-product` section.
 
 use core::f32::consts::TAU;
 
@@ -346,8 +342,7 @@ fn correction<W: Lanes>(table: &ProductTable<'_>, u1: W, u2: W, w: W) -> W {
             .enumerate()
         {
             let idx = base(a, b);
-            g[2 * c][lane] = table.value(idx);
-            g[2 * c + 1][lane] = table.value(idx + 1);
+            (g[2 * c][lane], g[2 * c + 1][lane]) = table.pair(idx);
         }
     }
     let at = |c: usize| {
