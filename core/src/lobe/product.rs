@@ -892,4 +892,30 @@ mod tests {
         }
         assert!(worst < 0.01, "{worst}");
     }
+
+    /// `pow2_range` on every binade from the smallest subnormal to `f32::MAX`: `k` is a power
+    /// of two, `k·n` lies in `[2⁻⁴⁹, 2⁴⁴]` and is exact (`(k·n)/k = n`), `(k·n)²` is
+    /// normal, and `k = 1` on `[2⁻²⁰, 2²⁰]`.
+    #[test]
+    fn pow2_range_keeps_the_square_normal() {
+        let mut n = f32::from_bits(1);
+        while n.is_finite() {
+            for m in [
+                n,
+                n * 1.5,
+                f32::from_bits(n.to_bits() | 0x007f_ffff).min(f32::MAX),
+            ] {
+                let k = pow2_range(Vec4::splat(m)).x;
+                assert_eq!(k.to_bits() & 0x007f_ffff, 0, "{m}: k = {k}");
+                let kn = k * m;
+                assert!((2f32.powi(-49)..=2f32.powi(44)).contains(&kn), "{m}: {kn}");
+                assert_eq!(kn / k, m, "{m}");
+                assert!((kn * kn).is_normal(), "{m}");
+                if (2f32.powi(-20)..=2f32.powi(20)).contains(&m) {
+                    assert_eq!(k, 1.0, "{m}");
+                }
+            }
+            n *= 2.0;
+        }
+    }
 }
