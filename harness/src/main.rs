@@ -31,7 +31,7 @@ enum Command {
         #[arg(long, default_value_t = 1 << 20)]
         n: usize,
         /// Timed runs of every throughput measurement, top table and sections alike, after
-        /// one untimed warm-up run (the median is reported).
+        /// an untimed warm-up of at least 30 ms (the median is reported).
         #[arg(long, default_value_t = 7)]
         repeats: usize,
         /// Rows compared against the f64 reference (hard cases first).

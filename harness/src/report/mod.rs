@@ -50,7 +50,7 @@ pub struct Options {
     /// it; the top table's errors are over its first `min(n, error_rows)` inputs.
     pub n: usize,
     /// Timed runs of every throughput measurement, of the top table and of every section
-    /// (after one untimed warm-up run; the median is reported).
+    /// (after an untimed warm-up of at least `timing::WARM_UP`; the median is reported).
     pub repeats: usize,
     /// Rows compared against the f64 reference (hard cases first).
     pub error_rows: usize,

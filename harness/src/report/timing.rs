@@ -1,6 +1,6 @@
 //! The report's timing helpers: every throughput figure of the report is the median of
-//! timed runs after one untimed warm-up run (caches, page faults, GPU pipelines), measured
-//! here. A leaf module.
+//! timed runs after an untimed warm-up (caches, page faults, GPU pipelines, the core's
+//! clock), measured here. A leaf module.
 
 use std::time::{Duration, Instant};
 
@@ -18,17 +18,32 @@ pub fn median(mut times: Vec<Duration>) -> Duration {
     times.get(times.len() / 2).copied().unwrap_or_default()
 }
 
-/// Median wall time of `f` over `repeats` timed runs (at least one) after one warm-up run.
-pub fn median_time(repeats: usize, mut f: impl FnMut()) -> Duration {
+/// The shortest warm-up: an idle core takes about 15 ms to reach its working clock. Timed
+/// from a cold start, the first 15 ms of a 3-band SH evaluation ran at 1.6× (scalar) and
+/// 1.7× (SIMD) their later time on the development machine, so a measurement shorter than
+/// that, taken first, read both slow and their ratio wrong.
+pub const WARM_UP: Duration = Duration::from_millis(30);
+
+/// Runs `f` at least once and until it has run for [`WARM_UP`].
+pub fn warm_up(mut f: impl FnMut()) {
+    let start = Instant::now();
     f();
+    while start.elapsed() < WARM_UP {
+        f();
+    }
+}
+
+/// Median wall time of `f` over `repeats` timed runs (at least one) after the warm-up.
+pub fn median_time(repeats: usize, mut f: impl FnMut()) -> Duration {
+    warm_up(&mut f);
     median((0..repeats.max(1)).map(|_| timed(&mut f).1).collect())
 }
 
-/// Median wall time of `f` after one warm-up run, over timed runs repeated until they fill
+/// Median wall time of `f` after the warm-up, over timed runs repeated until they fill
 /// `min_total` together: at least `repeats` and 3 runs, at most 50 (or `repeats`, if more).
 pub fn median_time_for(repeats: usize, min_total: Duration, mut f: impl FnMut()) -> Duration {
     let (least, most) = (repeats.max(3), repeats.max(50));
-    f();
+    warm_up(&mut f);
     let start = Instant::now();
     let mut times = Vec::new();
     while times.len() < least || (start.elapsed() < min_total && times.len() < most) {
@@ -37,21 +52,20 @@ pub fn median_time_for(repeats: usize, min_total: Duration, mut f: impl FnMut())
     median(times)
 }
 
-/// Median wall time of each of `count` contestants, `run(i)` running the `i`-th: one warm-up
-/// round, then `repeats` timed rounds (at least one) in which the contestants take turns, so
-/// that a noisy machine slows them alike and the ratios between them stay meaningful.
+/// Median wall time of each of `count` contestants, `run(i)` running the `i`-th: warm-up
+/// rounds (each contestant once per round, for [`WARM_UP`] together), then `repeats` timed
+/// rounds (at least one) in which the contestants take turns, so that a noisy machine slows
+/// them alike and the ratios between them stay meaningful.
 pub fn median_times_in_turns(
     repeats: usize,
     count: usize,
     mut run: impl FnMut(usize),
 ) -> Vec<Duration> {
+    warm_up(|| (0..count).for_each(&mut run));
     let mut times = vec![Vec::new(); count];
-    for round in 0..=repeats.max(1) {
+    for _ in 0..repeats.max(1) {
         for (i, t) in times.iter_mut().enumerate() {
-            let (_, d) = timed(|| run(i));
-            if round > 0 {
-                t.push(d);
-            }
+            t.push(timed(|| run(i)).1);
         }
     }
     times.into_iter().map(median).collect()
