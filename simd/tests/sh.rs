@@ -5,7 +5,7 @@
 
 use glam::Vec3;
 use steradian_core::sh::{self, MAX_BANDS};
-use steradian_simd::sh::{eval_slices, eval_x4, eval_x8};
+use steradian_simd::sh::{SLICE_LANES, eval_slices, eval_x4, eval_x8};
 
 use crate::common::lanes::{LENGTHS, in_every_lane, same};
 use crate::common::rng::Rng;
@@ -39,8 +39,10 @@ fn check(rows: &[Vec3], bands: usize) {
 #[test]
 fn random_directions_every_length_and_band_count() {
     let mut rng = Rng(0x5eed_0005);
-    for bands in [0usize, 1, 2, 3, 4, 5, 9, 10, 17, 30] {
-        for len in LENGTHS {
+    // Lengths of exactly one pass (4 and 8 lanes) take their own store path in the loop's
+    // band counts (11 and up).
+    for bands in [0usize, 1, 2, 3, 4, 5, 9, 10, 11, 17, 30] {
+        for len in LENGTHS.into_iter().chain([4, SLICE_LANES]) {
             let rows: Vec<Vec3> = (0..len)
                 .map(|_| rng.dir() * rng.log_range(1e-3, 1e3))
                 .collect();
@@ -61,7 +63,14 @@ fn special_values_in_every_component_and_lane() {
             Vec3::ZERO,
         ])
         .collect();
-    in_every_lane(&rows, Vec3::new(0.2, -0.3, 0.9), |r| check(r, 6));
+    in_every_lane(&rows, Vec3::new(0.2, -0.3, 0.9), |r| {
+        check(r, 6);
+        // The loop's band counts, and each row in every lane of one exact pass.
+        check(r, 12);
+        for pass in r.chunks(SLICE_LANES) {
+            check(pass, 12);
+        }
+    });
 }
 
 #[test]

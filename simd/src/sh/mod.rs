@@ -185,12 +185,16 @@ fn fill_loop<const H: bool, F: F64Lanes>(u: [F; 5], bands: usize, put: &mut impl
             }
             (q1[j], q2[j]) = (p1, p2);
         }
+        // The long run in `l` (`g = CHAINS` here): the chains' state in fixed-size copies,
+        // indexed only by constants, so that it stays in registers.
+        let (mut p1, mut p2) = (chains(&q1), chains(&q2));
+        let (ss, cc) = (chains(&ss), chains(&cc));
         for l in head..bands {
             let at = l * l + l;
             let k = tri(l, m0);
             for j in 0..CHAINS {
-                let q = step(k + j, q1[j], q2[j]);
-                (q2[j], q1[j]) = (q1[j], q);
+                let q = step(k + j, p1[j], p2[j]);
+                (p2[j], p1[j]) = (p1[j], q);
                 put(at - m0 - j, scaled(q * ss[j], il[l]));
                 put(at + m0 + j, scaled(q * cc[j], il[l]));
             }
@@ -198,6 +202,12 @@ fn fill_loop<const H: bool, F: F64Lanes>(u: [F; 5], bands: usize, put: &mut impl
         m0 += g;
     }
     put(0, sp(Y00_F64) + sp(0.0) * z);
+}
+
+/// The first [`CHAINS`] entries of a group's state.
+#[inline(always)]
+fn chains<F: F64Lanes>(v: &[F; MAX_GROUP]) -> [F; CHAINS] {
+    core::array::from_fn(|j| v[j])
 }
 
 /// Directions per pass of [`eval_slices`]: 8 where the build enables AVX-512F, 4 otherwise.
@@ -266,19 +276,29 @@ fn columns_any(x: &[f32], y: &[f32], z: &[f32], bands: usize, out: &mut [f32]) {
 
 /// The loops of [`eval_slices`] (shapes checked by it).
 ///
-/// `OWN`: the store closure owns its copies of the row, the length and the output slice,
-/// so the loop does not reload them after each store; faster for the dynamic band counts
-/// (the loop), slower for the straight-line code (`steradian report --section sh`).
+/// `LOOP`: the band count is not a constant (`fill_loop` runs). Then a single pass
+/// (`len = N`) stores whole rows of `out.as_chunks_mut::<N>()`, one bound check per
+/// coefficient instead of the slice's two; and over several passes the store closure owns
+/// its copies of the row, the length and the output slice, so the loop does not reload
+/// them after each store. Both are faster for the loop and were slower for the
+/// straight-line code (`steradian report --section sh`).
 #[inline(always)]
-fn columns<const OWN: bool>(x: &[f32], y: &[f32], z: &[f32], bands: usize, out: &mut [f32]) {
+fn columns<const LOOP: bool>(x: &[f32], y: &[f32], z: &[f32], bands: usize, out: &mut [f32]) {
     use slice_lanes::{L, N, narrow, point_lanes};
     let len = x.len();
     // Whole groups of lanes: one store of `N` values per coefficient.
     let whole = len - len % N;
     let col = |v: &[f32], i: usize| L::new(core::array::from_fn(|k| f64::from(v[i + k])));
+    if LOOP && len == N {
+        // One pass: `out` is `bands²` rows of `N` lanes, and each store is one row.
+        let u = point_lanes(col(x, 0), col(y, 0), col(z, 0));
+        let (rows, _) = out.as_chunks_mut::<N>();
+        fill(u, bands, &mut |c, v| rows[c] = narrow(v));
+        return;
+    }
     for i in (0..whole).step_by(N) {
         let u = point_lanes(col(x, i), col(y, i), col(z, i));
-        if OWN {
+        if LOOP {
             let dst = &mut *out;
             fill(u, bands, &mut move |c, v| {
                 let at = c * len + i;
