@@ -3,8 +3,9 @@
 //! Each input line is user data and is validated like every public constructor: a line
 //! that is not UTF-8, longer than [`MAX_LINE_BYTES`], not a JSON object, a missing or
 //! mistyped field, a vector of the wrong length, a non-finite number, a zero direction, a
-//! negative exponent, an angle outside the kernel's domain or a disk point outside the unit
-//! disk yields `{"error": "..."}` for that line and the run goes on. Lines end at `\n` (a
+//! negative exponent, an angle outside the kernel's domain, a disk point outside the unit
+//! disk, or a result that overflows `f32` yields `{"error": "..."}` for that line and the
+//! run goes on. Lines end at `\n` (a
 //! `\r` before it is dropped); a last line without `\n` counts; an empty or
 //! whitespace-only line is skipped (no output line). Input is read as bytes, so no byte
 //! sequence stops the run; only an I/O error of the streams does. Numbers are printed as
@@ -22,9 +23,39 @@ pub fn eval_line(kernel: &str, line: &str) -> Result<Value, String> {
     let obj = v
         .as_object()
         .ok_or_else(|| "each line must be a JSON object".to_string())?;
-    match registry::find(kernel).and_then(|k| k.eval.get()) {
-        Some(handler) => handler(obj),
-        None => Err(format!("unknown kernel {kernel}")),
+    let out = match registry::find(kernel).and_then(|k| k.eval.get()) {
+        Some(handler) => handler(obj)?,
+        None => return Err(format!("unknown kernel {kernel}")),
+    };
+    match first_null(&out, String::new()) {
+        Some(at) => Err(format!(
+            "the result {at} is not a finite f32 (it overflows)"
+        )),
+        None => Ok(out),
+    }
+}
+
+/// The path of the first `null` in `v` (where `json::num` wrote a non-finite `f32`), such
+/// as `coeffs[3]`: no handler answers `null` on purpose, so a `null` is a result that
+/// overflowed, and the line is a bad line rather than an answer with a hole in it.
+fn first_null(v: &Value, at: String) -> Option<String> {
+    match v {
+        Value::Null => Some(at),
+        Value::Array(a) => a
+            .iter()
+            .enumerate()
+            .find_map(|(i, x)| first_null(x, format!("{at}[{i}]"))),
+        Value::Object(o) => o.iter().find_map(|(k, x)| {
+            first_null(
+                x,
+                if at.is_empty() {
+                    k.clone()
+                } else {
+                    format!("{at}.{k}")
+                },
+            )
+        }),
+        _ => None,
     }
 }
 
@@ -181,6 +212,37 @@ mod tests {
             r#"{"axis": [0,0,1], "exponent": 2, "dir": [0, 0.6, 0.8]}"#,
         );
         assert!((v["value"].as_f64().unwrap() - 0.64).abs() < 1e-6);
+    }
+
+    #[test]
+    fn results_that_overflow_f32_are_bad_lines() {
+        // 2π·3e38, a rotation that adds two coefficients of 3e38, an irradiance of two.
+        for (kernel, line, at) in [
+            (
+                "lobe-integral",
+                r#"{"exponent": 0, "scale": 3e38}"#,
+                "integral",
+            ),
+            (
+                "sh-rotate",
+                r#"{"coeffs": [0, 3e38, 0, 3e38], "rotation": [[0.70710678, -0.70710678, 0], [0.70710678, 0.70710678, 0], [0, 0, 1]]}"#,
+                "coeffs[",
+            ),
+            (
+                "sh-irradiance",
+                r#"{"coeffs": [3e38, 0, 3e38, 0], "normal": [0, 0, 1]}"#,
+                "irradiance",
+            ),
+        ] {
+            let v = one(kernel, line);
+            let e = v["error"]
+                .as_str()
+                .unwrap_or_else(|| panic!("{kernel}: {v}"));
+            assert!(e.contains(at) && e.contains("overflows"), "{kernel}: {e}");
+        }
+        // The same kernels just below overflow answer in full.
+        let v = one("lobe-integral", r#"{"exponent": 0, "scale": 5e37}"#);
+        assert!(v["integral"].is_number(), "{v}");
     }
 
     #[test]
