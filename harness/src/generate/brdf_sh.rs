@@ -21,7 +21,8 @@
 //! coefficients at the midpoints by at most `target/10` of their norm.
 
 use rayon::prelude::*;
-use steradian_core::sh::brdf::{TABLE_NAME, stored};
+use steradian_core::sh::brdf::{self, BrdfSh, Part, TABLE_NAME, stored};
+use steradian_core::sh::window::Window;
 use steradian_core::table::{HEADER_LEN, Spec, encode_into};
 use steradian_reference::lobe::brdf::Model;
 use steradian_reference::sh as shref;
@@ -247,6 +248,41 @@ pub fn table(model: &Model, bands: usize, samples: usize) -> Vec<u8> {
     out
 }
 
+/// The relative L2 errors against `F` at `θₒ` of what the table `t` gives there, one per
+/// window: its own band count, interpolated between its views (`BrdfSh::lookup_into`), each
+/// band `l` weighted by the window's `w(l, n)`. The stored basis is orthonormal (module
+/// docs), so by Parseval `‖F − T‖² = ‖F‖² − 2⟨f, t⟩ + ‖t‖²` with `f` the exact coefficients
+/// through [`MAX_BANDS`] and `‖F‖²` by quadrature: truncation, interpolation, the window and
+/// the `f32` storage together.
+pub fn table_errors(model: &Model, t: &BrdfSh<'_>, theta_o: f64, windows: &[Window]) -> Vec<f64> {
+    let nodes = Nodes::new(model.feature_angle(), MAX_BANDS, 1);
+    let (f, _, norm2, _) = project(model, &nodes, theta_o);
+    let n = t.bands();
+    let mut got = vec![0.0f32; n * n];
+    t.lookup_into(Part::WithCosine, theta_o as f32, n, &mut got)
+        .expect("the table's own band count");
+    windows
+        .iter()
+        .map(|w| {
+            let (mut cross, mut tt) = (0.0, 0.0);
+            for l in 0..n {
+                let wl = w.weight(l, n);
+                for m in 0..=l {
+                    let tv = wl * f64::from(got[l * l + l + m]);
+                    cross += f[stored(l) + m] * tv;
+                    tt += tv * tv;
+                }
+            }
+            ((norm2 - 2.0 * cross + tt).max(0.0) / norm2).sqrt()
+        })
+        .collect()
+}
+
+/// The committed table of `materials()[k]` (core's built-in, the same order).
+pub fn committed(k: usize) -> BrdfSh<'static> {
+    [brdf::lambert, brdf::phong, brdf::lafortune, brdf::ggx][k]()
+}
+
 /// Target truncation error of the built-in tables (relative L2 at `θₒ = 45°`).
 pub const TARGET: f64 = 0.05;
 
@@ -321,6 +357,21 @@ pub fn generate_ggx() -> Vec<u8> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn at_a_stored_view_the_table_error_is_the_truncation_error() {
+        // At a sample the interpolation weight is 0: what is left is the truncation to the
+        // table's bands (and the f32 storage, far below the tolerance).
+        for (k, m) in materials().iter().enumerate() {
+            let t = committed(k);
+            let th = f64::from(t.theta(t.samples() / 2));
+            let nodes = Nodes::new(m.model.feature_angle(), MAX_BANDS, 1);
+            let (f, _, n2, _) = project(&m.model, &nodes, th);
+            let want = truncation_errors(&f, n2, MAX_BANDS, |_, _| 1.0)[t.bands() - 1];
+            let got = table_errors(&m.model, &t, th, &[Window::None])[0];
+            assert!((got - want).abs() < 1e-5, "{}: {got} vs {want}", m.name);
+        }
+    }
 
     #[test]
     fn the_quadrature_has_converged() {

@@ -380,27 +380,64 @@ fn hvl_rows(opts: &Options, gpu: &mut Option<Gpu>) -> Vec<HvlRow> {
         .collect()
 }
 
-/// Per built-in material: (name, bands, samples, bytes, errors at [3, 5, 7, 9, 11, 14] for
-/// no window, Hanning, Cesàro).
-type BrdfRow = (&'static str, usize, usize, usize, [[f64; 6]; 3]);
+/// Per built-in material: the committed table's shape and bytes, the truncation errors at
+/// `θₒ = 45°` for band limits [3, 5, 7, 9, 11, 14], and the committed table's own error over
+/// every view; each for no window, Hanning and Cesàro.
+struct BrdfRow {
+    name: &'static str,
+    bands: usize,
+    samples: usize,
+    bytes: usize,
+    truncation: [[f64; 6]; 3],
+    /// Mean and largest of `brdf_sh::table_errors` over [`BRDF_VIEWS`] views.
+    table: [[f64; 2]; 3],
+}
+
+/// Views at which the committed tables are checked: `θₒ = (i + ½)·90°/180`, between the
+/// stored views and beyond the last one (where the lookup holds the last view).
+const BRDF_VIEWS: usize = 180;
 
 fn brdf_rows() -> Vec<BrdfRow> {
+    use rayon::prelude::*;
     let limits = [3usize, 5, 7, 9, 11, 14];
+    let windows = [Window::None, Window::Hanning, Window::Cesaro];
     brdf_sh::materials()
         .iter()
-        .map(|m| {
-            let bands = brdf_sh::choose_bands(&m.model, brdf_sh::TARGET).max(3);
-            let samples = brdf_sh::choose_samples(&m.model, bands, brdf_sh::TARGET);
+        .enumerate()
+        .map(|(k, m)| {
+            let t = brdf_sh::committed(k);
+            let (bands, samples) = (t.bands(), t.samples());
             let bytes =
                 steradian_core::table::HEADER_LEN + 4 * samples * 2 * sh::brdf::stored(bands);
             let nodes = brdf_sh::Nodes::new(m.model.feature_angle(), brdf_sh::MAX_BANDS, 1);
             let (f, _, n2, _) = brdf_sh::project(&m.model, &nodes, std::f64::consts::FRAC_PI_4);
-            let errs = [Window::None, Window::Hanning, Window::Cesaro].map(|w| {
+            let truncation = windows.map(|w| {
                 let e =
                     brdf_sh::truncation_errors(&f, n2, brdf_sh::MAX_BANDS, |l, n| w.weight(l, n));
                 limits.map(|n| e[n - 1])
             });
-            (m.name, bands, samples, bytes, errs)
+            let per_view: Vec<Vec<f64>> = (0..BRDF_VIEWS)
+                .into_par_iter()
+                .map(|i| {
+                    let th = (i as f64 + 0.5) * std::f64::consts::FRAC_PI_2 / BRDF_VIEWS as f64;
+                    brdf_sh::table_errors(&m.model, &t, th, &windows)
+                })
+                .collect();
+            let table = core::array::from_fn(|w| {
+                let e = per_view.iter().map(|v| v[w]);
+                [
+                    e.clone().sum::<f64>() / BRDF_VIEWS as f64,
+                    e.fold(0.0, f64::max),
+                ]
+            });
+            BrdfRow {
+                name: m.name,
+                bands,
+                samples,
+                bytes,
+                truncation,
+                table,
+            }
         })
         .collect()
 }
@@ -682,18 +719,28 @@ pub fn section(opts: &Options) -> Result<Section, Box<dyn Error>> {
     }
     html.push_str("</table>");
 
-    html.push_str("<h3>BRDF SH tables</h3><p>Relative L2 truncation error of F at θₒ = 45° (Parseval on 16 bands of coefficients), without a window / Hanning / Cesàro, per band limit.</p><table><tr><th>material</th><th>table (bands × views, bytes)</th><th>window</th><th>3</th><th>5</th><th>7</th><th>9</th><th>11</th><th>14</th></tr>");
-    for (name, bands, samples, bytes, errs) in &brdf {
+    html.push_str("<h3>BRDF SH tables</h3><p>Relative L2 error of F against the BRDF: the truncation error at θₒ = 45° per band limit (Parseval on 16 bands of coefficients), and the committed table's own error (its bands, interpolated between its views, f32) over 180 views θₒ = (i + ½)·0.5°, mean and largest; without a window, Hanning, Cesàro. The generator picks the fewest bands with a 45° truncation error of at most 5 % and the fewest views with a mid-view interpolation error of at most 0.5 %.</p><table><tr><th>material</th><th>table (bands × views, bytes)</th><th>window</th><th>3</th><th>5</th><th>7</th><th>9</th><th>11</th><th>14</th><th>table, mean over views</th><th>table, largest</th></tr>");
+    for r in &brdf {
         for (k, w) in ["none", "Hanning", "Cesàro"].iter().enumerate() {
             write!(
                 html,
-                "<tr><td>{name}</td><td>{bands} × {samples}, {bytes}</td><td>{w}</td>"
+                "<tr><td>{}</td><td>{} × {}, {}</td><td>{w}</td>",
+                r.name, r.bands, r.samples, r.bytes
             )?;
-            for e in errs[k] {
+            for e in r.truncation[k] {
                 write!(html, "<td>{e:.3}</td>")?;
             }
-            html.push_str("</tr>");
+            write!(
+                html,
+                "<td>{:.4}</td><td>{:.4}</td></tr>",
+                r.table[k][0], r.table[k][1]
+            )?;
         }
+        writeln!(
+            summary,
+            "BRDF table {}: {} bands × {} views, error over every view mean {:.4}, largest {:.4} (no window)",
+            r.name, r.bands, r.samples, r.table[0][0], r.table[0][1]
+        )?;
     }
     html.push_str("</table>");
 
@@ -753,10 +800,15 @@ pub fn section(opts: &Options) -> Result<Section, Box<dyn Error>> {
         "hvl_table1": t1.rows.iter().map(|(m, n, us, e)| json!({
             "hvls": m, "bands": n, "us_per_point": us, "error_lambert": e[0], "error_phong30": e[1],
         })).collect::<Vec<_>>(),
-        "brdf_tables": brdf.iter().map(|(name, bands, samples, bytes, errs)| json!({
-            "material": name, "bands": bands, "views": samples, "bytes": bytes,
+        "brdf_tables": brdf.iter().map(|r| json!({
+            "material": r.name, "bands": r.bands, "views": r.samples, "bytes": r.bytes,
             "band_limits": [3, 5, 7, 9, 11, 14],
-            "error": {"none": errs[0], "hanning": errs[1], "cesaro": errs[2]},
+            "error": {"none": r.truncation[0], "hanning": r.truncation[1], "cesaro": r.truncation[2]},
+            "table_error": {
+                "none": {"mean": r.table[0][0], "max": r.table[0][1]},
+                "hanning": {"mean": r.table[1][0], "max": r.table[1][1]},
+                "cesaro": {"mean": r.table[2][0], "max": r.table[2][1]},
+            },
         })).collect::<Vec<_>>(),
         "windows": windows.iter().map(|(n, v)| json!({"window": n, "most_negative": v})).collect::<Vec<_>>(),
     });
