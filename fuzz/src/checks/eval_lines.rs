@@ -1,7 +1,8 @@
 //! The `steradian eval` line layer on arbitrary bytes: for every registered eval kernel (the
 //! first byte picks it), exactly one output line per non-blank input line, each a JSON
-//! object with exactly one of the kernel's answer or `"error"`, and never a panic (a small
-//! line limit so that over-long lines are exercised too).
+//! object with exactly one of the kernel's answer or `"error"`, no answer holding `null` (a
+//! number that did not fit `f32`), and never a panic (a small line limit so that over-long
+//! lines are exercised too).
 
 use steradian_harness::{eval, registry};
 
@@ -42,7 +43,19 @@ pub fn check(data: &[u8]) {
         if obj.contains_key("error") {
             assert_eq!(obj.len(), 1, "an error line holds only the error: {l}");
             seen_errors += 1;
+        } else {
+            assert!(!holds_null(&v), "an answer with a non-finite number: {l}");
         }
     }
     assert_eq!(seen_errors, errors);
+}
+
+/// Whether `v` holds a `null` anywhere.
+fn holds_null(v: &serde_json::Value) -> bool {
+    match v {
+        serde_json::Value::Null => true,
+        serde_json::Value::Array(a) => a.iter().any(holds_null),
+        serde_json::Value::Object(o) => o.values().any(holds_null),
+        _ => false,
+    }
 }
