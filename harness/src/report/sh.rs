@@ -59,31 +59,38 @@ fn eval_rows(opts: &Options, gpu: &mut Option<Gpu>) -> Vec<EvalRow> {
                 dirs.iter().map(|d| d[1]).collect(),
                 dirs.iter().map(|d| d[2]).collect(),
             );
-            // The SIMD kernel writes eight directions' columns per call into one reused
-            // buffer (`8·n²` values, in L1 through 30 bands), as the scalar kernel writes
-            // one direction's `n²` values into one: neither pays for a scatter to memory.
+            // The SIMD kernel writes eight directions' columns per call (`8·n²` values), the
+            // scalar kernel one direction's `n²` values, each into one reused buffer (in L1
+            // or L2 through 30 bands): neither pays for a scatter to memory. Each call starts
+            // 64 bytes after the last one (modulo `RING` steps, the buffer `RING·64` bytes
+            // longer than one call's output), so over a run the output takes every alignment
+            // modulo 4 KiB. Where the output aliased the stack modulo 4 KiB, one fixed
+            // position made a run's scalar 5-band time 1.3× (a false store-to-load
+            // dependence at the call's return; which runs, by where the stack started).
+            const RING: usize = 64;
             let chunk = 8;
-            let mut out = vec![0.0f32; nn];
-            let mut cols = vec![0.0f32; nn * chunk];
+            let mut out = vec![0.0f32; nn + 16 * RING];
+            let mut cols = vec![0.0f32; nn * chunk + 16 * RING];
             let mut plain = vec![0.0f64; nn];
             let counts = [dirs.len(), dirs.len(), dirs.len(), peer_dirs];
             let t = median_times_in_turns(opts.repeats.min(5), 4, |k| match k {
                 0 => {
-                    for d in &dirs {
-                        sh::eval_into(Vec3::from(*d), n, &mut out).expect("shape");
+                    for (i, d) in dirs.iter().enumerate() {
+                        let at = (i % RING) * 16;
+                        sh::eval_into(Vec3::from(*d), n, &mut out[at..at + nn]).expect("shape");
                         black_box(&out);
                     }
                 }
                 1 => {
                     for s in (0..dirs.len()).step_by(chunk) {
                         let e = (s + chunk).min(dirs.len());
-                        let len = e - s;
+                        let at = (s / chunk % RING) * 16;
                         steradian_simd::sh::eval_slices(
                             &x[s..e],
                             &y[s..e],
                             &z[s..e],
                             n,
-                            &mut cols[..nn * len],
+                            &mut cols[at..at + nn * (e - s)],
                         )
                         .expect("shape");
                         black_box(&cols);
@@ -105,8 +112,8 @@ fn eval_rows(opts: &Options, gpu: &mut Option<Gpu>) -> Vec<EvalRow> {
             // Correctness on 64 directions, every implementation.
             let mut identity = [0.0f64; 4];
             for d in dirs.iter().take(64) {
-                sh::eval_into(Vec3::from(*d), n, &mut out).expect("shape");
-                let ours: Vec<f64> = out.iter().map(|&v| f64::from(v)).collect();
+                sh::eval_into(Vec3::from(*d), n, &mut out[..nn]).expect("shape");
+                let ours: Vec<f64> = out[..nn].iter().map(|&v| f64::from(v)).collect();
                 study::plain_eval(d.map(f64::from), n, &norms, &mut plain);
                 let peer = study::sphrs_eval(&set, d.map(f64::from));
                 let errs = [
