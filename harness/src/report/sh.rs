@@ -73,7 +73,10 @@ fn eval_rows(opts: &Options, gpu: &mut Option<Gpu>) -> Vec<EvalRow> {
             let mut cols = vec![0.0f32; nn * chunk + 16 * RING];
             let mut plain = vec![0.0f64; nn];
             let counts = [dirs.len(), dirs.len(), dirs.len(), peer_dirs];
-            let t = median_times_in_turns(opts.repeats.min(5), 4, |k| match k {
+            // Three times the report's rounds: a round is short (from 0.3 ms at 3 bands), and
+            // on a shared host a kernel runs about 1.6× slower in bursts of up to a few ms,
+            // which five rounds could fall inside.
+            let t = median_times_in_turns(3 * opts.repeats, 4, |k| match k {
                 0 => {
                     for (i, d) in dirs.iter().enumerate() {
                         let at = (i % RING) * 16;
