@@ -17,7 +17,7 @@ use super::Options;
 use super::memory;
 use super::plot::{Axis, Chart, Pt, Scale, Series};
 use super::section::Section;
-use super::timing::{median_time, ns_per};
+use super::timing::{median_time, median_times_in_turns, ns_per};
 use crate::backend::gpu::try_gpu;
 use crate::kernels::Columns;
 use crate::rng::Rng;
@@ -384,25 +384,36 @@ pub fn measure(opts: &Options) -> Result<SatResults, Box<dyn Error>> {
     let qs = &qs[..queries];
     let cols = Columns::from_rows(qs);
     let mut out = vec![0.0f32; queries];
-    let scalar = median_time(reps, || {
-        for (o, q) in out.iter_mut().zip(qs) {
-            *o = view.box_sum(q[0], q[1], q[2], q[3]);
-        }
-        black_box(&out);
-    });
-    let scalar_out = out.clone();
     let mut simd_out = vec![0.0f32; queries];
-    let simd = median_time(reps, || {
-        steradian_simd::rsl::sat::box_sum_slices(
-            &view,
-            cols.col(0),
-            cols.col(1),
-            cols.col(2),
-            cols.col(3),
-            &mut simd_out,
-        );
-        black_box(&simd_out);
+    // The loads alone, the same entries in the same order: the floor of this layout.
+    let sums = view.sums();
+    let cold_plan = load_plan(&view, qs);
+    // Scalar, SIMD and the floor take turns, so that the host's bursts of interference
+    // slow them alike and the ratios between them hold.
+    let cold = median_times_in_turns(reps, 3, |k| match k {
+        0 => {
+            for (o, q) in out.iter_mut().zip(qs) {
+                *o = view.box_sum(q[0], q[1], q[2], q[3]);
+            }
+            black_box(&out);
+        }
+        1 => {
+            steradian_simd::rsl::sat::box_sum_slices(
+                &view,
+                cols.col(0),
+                cols.col(1),
+                cols.col(2),
+                cols.col(3),
+                &mut simd_out,
+            );
+            black_box(&simd_out);
+        }
+        _ => {
+            black_box(sum_loads(sums, black_box(&cold_plan)));
+        }
     });
+    let (scalar, simd, cold_loads) = (cold[0], cold[1], cold[2]);
+    let scalar_out = out.clone();
     let simd_bit_exact = scalar_out
         .iter()
         .zip(&simd_out)
@@ -441,27 +452,34 @@ pub fn measure(opts: &Options) -> Result<SatResults, Box<dyn Error>> {
     let warm = &qs[..warm_n];
     let wc = Columns::from_rows(warm);
     let mut wout = vec![0.0f32; warm_n];
-    let warm_scalar = median_time(reps, || {
+    let warm_plan = load_plan(&view, warm);
+    let warm_t = median_times_in_turns(reps, 3, |k| {
         for _ in 0..rounds {
-            for (o, q) in wout.iter_mut().zip(warm) {
-                *o = view.box_sum(q[0], q[1], q[2], q[3]);
+            match k {
+                0 => {
+                    for (o, q) in wout.iter_mut().zip(warm) {
+                        *o = view.box_sum(q[0], q[1], q[2], q[3]);
+                    }
+                    black_box(&wout);
+                }
+                1 => {
+                    steradian_simd::rsl::sat::box_sum_slices(
+                        &view,
+                        wc.col(0),
+                        wc.col(1),
+                        wc.col(2),
+                        wc.col(3),
+                        &mut wout,
+                    );
+                    black_box(&wout);
+                }
+                _ => {
+                    black_box(sum_loads(sums, black_box(&warm_plan)));
+                }
             }
-            black_box(&wout);
         }
     });
-    let warm_simd = median_time(reps, || {
-        for _ in 0..rounds {
-            steradian_simd::rsl::sat::box_sum_slices(
-                &view,
-                wc.col(0),
-                wc.col(1),
-                wc.col(2),
-                wc.col(3),
-                &mut wout,
-            );
-            black_box(&wout);
-        }
-    });
+    let (warm_scalar, warm_simd, warm_loads) = (warm_t[0], warm_t[1], warm_t[2]);
     let warm_f32_int = median_time(reps, || {
         for _ in 0..rounds {
             for (o, q) in wout.iter_mut().zip(&iq[..warm_n]) {
@@ -477,18 +495,6 @@ pub fn measure(opts: &Options) -> Result<SatResults, Box<dyn Error>> {
             }
             black_box(&wout);
         }
-    });
-    // The loads alone, the same entries in the same order: the floor of this layout.
-    let sums = view.sums();
-    let warm_plan = load_plan(&view, warm);
-    let warm_loads = median_time(reps, || {
-        for _ in 0..rounds {
-            black_box(sum_loads(sums, black_box(&warm_plan)));
-        }
-    });
-    let cold_plan = load_plan(&view, qs);
-    let cold_loads = median_time(reps, || {
-        black_box(sum_loads(sums, black_box(&cold_plan)));
     });
     // Entries read per box (rows reused where a fraction is 0 are not read again) and
     // distinct cache lines (two per row unless the two column pairs share one).
