@@ -736,7 +736,8 @@ fn assert_choice<T: Copy + PartialEq + std::fmt::Debug>(
 }
 
 /// `rsl` plans K from the target error (`choose_k`): the estimates fall with K, the chosen
-/// K is the smallest within `PLAN_SHARE` of the target, a loose target takes a small K, and the
+/// K is the smallest within `PLAN_SHARE` of the target (the visibility-map side and the
+/// cube-map face by the same rule), a loose target takes a small K, and the
 /// render at the chosen K meets the target against the path tracer (plus four times the
 /// reference's noise) at 48 columns, with under half the noise-corrected relative L2 of
 /// the paper's K = 30.
@@ -753,21 +754,30 @@ fn rsl_plans_k_from_the_target_error() {
     assert_eq!(c.side_estimates.last(), Some(&(64, 0.0)));
     assert_choice(&c.side_estimates, c.vis_side, target);
     assert_eq!(c.vis_side, 16);
+    // The cube-map face by the same rule, every candidate holding K texels.
+    assert_eq!(c.face_estimates.last(), Some(&(64, 0.0)));
+    assert!(c.face_estimates.iter().all(|&(f, _)| 6 * f * f >= c.k));
+    assert_choice(&c.face_estimates, c.face, target);
     let loose = rsl::choose_k(&small.scene, &o, 0.05).unwrap();
     assert!(loose.k < c.k, "{loose:?}");
     assert!(loose.vis_side <= c.vis_side, "{loose:?}");
+    assert!(loose.face <= c.face, "{loose:?}");
     let img = rsl::render(
         &small.scene,
         &rsl::Options {
             k: c.k,
             vis_side: c.vis_side,
+            face: c.face,
             ..o
         },
         &ProgressBar::hidden(),
     )
     .unwrap();
     let m = small.errors(&img);
-    eprintln!("rsl at K = {}, side {}: {m:?}", c.k, c.vis_side);
+    eprintln!(
+        "rsl at K = {}, side {}, face {}: {m:?}",
+        c.k, c.vis_side, c.face
+    );
     assert!(
         m.mean_abs_over_max < target + 4.0 * m.reference_noise_over_max,
         "{m:?}"

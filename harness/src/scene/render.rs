@@ -189,22 +189,40 @@ pub fn plan(scene: &Scene, o: &Options) -> Result<Plan, String> {
             use steradian_core::rsl::visibility::DEPTH_BOUNDS;
             r.vis_depth = super::rsl::coverage_depth_for(o.target_error);
             let choice = super::rsl::choose_k(scene, &r, o.target_error)?;
+            let k_face = r.face;
             r.k = choice.k;
             r.vis_side = choice.vis_side;
+            r.face = choice.face;
             let est = estimates_text("K = ", &choice.estimates);
             p.push(PlanItem {
                 item: "rsls".into(),
                 value: json!(r.k),
                 reason: format!(
-                    "K square lights from a 6 × {}² cube map: the smallest of {:?} whose \
-                     decomposition alone keeps {} probe pixels within {} of the target {} of \
-                     the largest ({}; the RSL paper uses K = 30)",
-                    r.face,
+                    "K square lights: the smallest of {:?} whose decomposition of a 6 × {}² \
+                     cube map alone keeps {} probe pixels within {} of the target {} of the \
+                     largest ({}; the RSL paper uses K = 30)",
                     super::rsl::K_CANDIDATES,
+                    k_face,
                     super::PROBES.0 * super::PROBES.1,
                     super::PLAN_SHARE,
                     o.target_error,
                     est
+                ),
+            });
+            p.push(PlanItem {
+                item: "cube_face".into(),
+                value: json!(r.face),
+                reason: format!(
+                    "the environment resampled to a 6 × {0}² cube map before the decomposition: \
+                     {0} is the smallest side of {1:?} (at least K texels) whose {2} lights keep \
+                     the probe pixels within {3} of the target {4} of the largest side's, with \
+                     the chosen visibility maps ({5})",
+                    r.face,
+                    super::rsl::FACE_CANDIDATES,
+                    r.k,
+                    super::PLAN_SHARE,
+                    o.target_error,
+                    estimates_text("face ", &choice.face_estimates)
                 ),
             });
             p.push(PlanItem {

@@ -34,7 +34,7 @@ use super::image::Image;
 use super::material::Material;
 use super::{Rgb, Scene, Seen, ShadingPoint, Shape, render_centres};
 use crate::env::Equirect;
-use crate::env::decompose::decompose;
+use crate::env::decompose::{Decomposition, decompose};
 
 /// Settings of the `rsl` method.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -94,6 +94,44 @@ pub fn build(scene: &Scene, o: &Options) -> Result<Built, String> {
     })
 }
 
+/// The environment (times its scale) resampled to a cube map of `face`² texels per face and
+/// decomposed into each of `ks` square lights: `(K, lights)` in the order asked, and the
+/// partitions themselves (one per distinct `K`, largest first).
+#[allow(clippy::type_complexity)]
+fn decompose_env(
+    scene: &Scene,
+    face: usize,
+    ks: &[usize],
+) -> Result<(Vec<(usize, Vec<ShadeLight>)>, Vec<Decomposition>), String> {
+    let env = scene
+        .environment
+        .as_ref()
+        .ok_or("method rsl lights with an environment; this scene has none")?;
+    let scaled: Vec<[f32; 3]> = env
+        .image
+        .data()
+        .iter()
+        .map(|p| p.map(|v| (v as f64 * env.scale) as f32))
+        .collect();
+    let eq =
+        Equirect::new(env.image.width(), env.image.height(), scaled).map_err(|e| e.to_string())?;
+    let cube = eq.to_cubemap(face).map_err(|e| e.to_string())?;
+    let decs =
+        decompose(&cube, &crate::env::decompose::Options::quiet(ks)).map_err(|e| e.to_string())?;
+    let lights = ks
+        .iter()
+        .map(|&k| {
+            let d = decs
+                .iter()
+                .find(|d| d.k == k)
+                .ok_or_else(|| format!("no partition into {k} lights"))?;
+            let l = d.rsls().map_err(|e| e.to_string())?;
+            Ok((k, l.iter().map(ShadeLight::from).collect()))
+        })
+        .collect::<Result<Vec<_>, String>>()?;
+    Ok((lights, decs))
+}
+
 /// [`build`] for several `K` at once: one decomposition run (the partitions are nested)
 /// and one set of BRDF SATs fitted over all of them.
 pub struct BuiltMany {
@@ -108,33 +146,7 @@ pub struct BuiltMany {
 /// The environment (times its scale) decomposed into each of `ks` square lights, and the
 /// SATs the materials need, fitted over every decomposition.
 pub fn build_many(scene: &Scene, o: &Options, ks: &[usize]) -> Result<BuiltMany, String> {
-    let env = scene
-        .environment
-        .as_ref()
-        .ok_or("method rsl lights with an environment; this scene has none")?;
-    let scaled: Vec<[f32; 3]> = env
-        .image
-        .data()
-        .iter()
-        .map(|p| p.map(|v| (v as f64 * env.scale) as f32))
-        .collect();
-    let eq =
-        Equirect::new(env.image.width(), env.image.height(), scaled).map_err(|e| e.to_string())?;
-    let cube = eq.to_cubemap(o.face).map_err(|e| e.to_string())?;
-    let decs =
-        decompose(&cube, &crate::env::decompose::Options::quiet(ks)).map_err(|e| e.to_string())?;
-    // `decompose` returns one partition per distinct K, largest first.
-    let lights = ks
-        .iter()
-        .map(|&k| {
-            let d = decs
-                .iter()
-                .find(|d| d.k == k)
-                .ok_or_else(|| format!("no partition into {k} lights"))?;
-            let l = d.rsls().map_err(|e| e.to_string())?;
-            Ok((k, l.iter().map(ShadeLight::from).collect()))
-        })
-        .collect::<Result<Vec<_>, String>>()?;
+    let (lights, decs) = decompose_env(scene, o.face, ks)?;
     let refs: Vec<_> = decs.iter().collect();
     let lambert = crate::shade::fit_sat(
         &Lambert::new(1.0).map_err(|e| e.to_string())?,
@@ -162,6 +174,9 @@ pub const K_CANDIDATES: [usize; 5] = [10, 30, 100, 300, 1000];
 /// The visibility-map sides a plan tries, smallest first ([`choose_k`]).
 pub const VIS_SIDE_CANDIDATES: [usize; 4] = [8, 16, 32, 64];
 
+/// The cube-map face sides a plan tries, smallest first ([`choose_k`]).
+pub const FACE_CANDIDATES: [usize; 3] = [16, 32, 64];
+
 /// What [`choose_k`] chose and what it measured.
 #[derive(Clone, Debug)]
 pub struct KChoice {
@@ -174,6 +189,10 @@ pub struct KChoice {
     pub vis_side: usize,
     /// `(side, estimate)` with the chosen `K`, as for `estimates`.
     pub side_estimates: Vec<(usize, f64)>,
+    /// The chosen cube-map face side.
+    pub face: usize,
+    /// `(face, estimate)` with the chosen `K`, as for `estimates`.
+    pub face_estimates: Vec<(usize, f64)>,
 }
 
 /// The smallest `K` of [`K_CANDIDATES`] whose light decomposition alone keeps the shaded
@@ -189,6 +208,11 @@ pub struct KChoice {
 /// [`VIS_SIDE_CANDIDATES`] by the same rule against the largest side (the probes' maps
 /// built at each side, at `o.vis_depth`): the cost of a point's map grows with its area
 /// while its error stops falling once the texels resolve the occluders' caps.
+///
+/// Last, with the chosen `K` and side, the smallest cube-map face of [`FACE_CANDIDATES`]
+/// (holding at least `K` texels) by the same rule against the largest face: the
+/// decomposition's cost grows with the face's area, while `K` squares cannot show detail
+/// finer than they are.
 pub fn choose_k(scene: &Scene, o: &Options, target: f64) -> Result<KChoice, String> {
     let texels = 6 * o.face * o.face;
     let ks: Vec<usize> = K_CANDIDATES
@@ -249,11 +273,38 @@ pub fn choose_k(scene: &Scene, o: &Options, target: f64) -> Result<KChoice, Stri
         .collect();
     let (vis_side, side_estimates) = super::plan_choice(&VIS_SIDE_CANDIDATES, &side_images, target)
         .ok_or("no visibility-map side")?;
+    // The cube-map face with the chosen K and side (the SATs shared, fitted above).
+    let os = Options { vis_side, ..*o };
+    let mut cov = vec![0.0f32; vis_side * vis_side];
+    let probes: Vec<_> = points
+        .iter()
+        .filter_map(|p| point_moments(scene, &os, p, &mut cov).map(|t| (p, t)))
+        .collect();
+    let faces: Vec<usize> = FACE_CANDIDATES
+        .iter()
+        .copied()
+        .filter(|&f| 6 * f * f >= k)
+        .collect();
+    let mut face_images = Vec::new();
+    for &f in &faces {
+        let (mut lights, _) = decompose_env(scene, f, &[k])?;
+        b.lights = lights.remove(0).1;
+        face_images.push(
+            probes
+                .iter()
+                .map(|(p, (frame, m))| shade_with(scene, &b, p, frame, m))
+                .collect::<Vec<Rgb>>(),
+        );
+    }
+    let (face, face_estimates) =
+        super::plan_choice(&faces, &face_images, target).ok_or("no cube-map face holds K")?;
     Ok(KChoice {
         k,
         estimates,
         vis_side,
         side_estimates,
+        face,
+        face_estimates,
     })
 }
 
