@@ -29,7 +29,7 @@ pub fn eval_line(kernel: &str, line: &str) -> Result<Value, String> {
     };
     match first_null(&out, String::new()) {
         Some(at) => Err(format!(
-            "the result {at} is not a finite f32 (it overflows)"
+            "the result {at} is not a finite f32 (it overflows f32's range)"
         )),
         None => Ok(out),
     }

@@ -18,10 +18,10 @@ pub fn median(mut times: Vec<Duration>) -> Duration {
     times.get(times.len() / 2).copied().unwrap_or_default()
 }
 
-/// The shortest warm-up: an idle core takes about 15 ms to reach its working clock. Timed
-/// from a cold start, the first 15 ms of a 3-band SH evaluation ran at 1.6× (scalar) and
-/// 1.7× (SIMD) their later time on the development machine, so a measurement shorter than
-/// that, taken first, read both slow and their ratio wrong.
+/// The shortest warm-up. A process's first milliseconds run slower (caches, page faults,
+/// the core's clock leaving idle): a measurement of a few µs taken first fell inside them,
+/// read slow, and gave its contestants a wrong ratio (the SH section's 3-band evaluation,
+/// the first it times; `steradian report --section sh` shows it without the warm-up).
 pub const WARM_UP: Duration = Duration::from_millis(30);
 
 /// Runs `f` at least once and until it has run for [`WARM_UP`].
