@@ -285,10 +285,15 @@ pub fn choose_k(scene: &Scene, o: &Options, target: f64) -> Result<KChoice, Stri
         .copied()
         .filter(|&f| 6 * f * f >= k)
         .collect();
+    // At `o.face` the chosen K's lights are those above.
+    let at_face = std::mem::take(&mut b.lights);
     let mut face_images = Vec::new();
     for &f in &faces {
-        let (mut lights, _) = decompose_env(scene, f, &[k])?;
-        b.lights = lights.remove(0).1;
+        b.lights = if f == o.face {
+            at_face.clone()
+        } else {
+            decompose_env(scene, f, &[k])?.0.remove(0).1
+        };
         face_images.push(
             probes
                 .iter()
