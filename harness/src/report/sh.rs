@@ -685,8 +685,8 @@ pub fn section(opts: &Options) -> Result<Section, Box<dyn Error>> {
          reflective shadow map, radius r2 (eq. 25, k = 1); 48 receivers on a wall beside it \
          seen from one eye. Time: all M contributions per shading point, scalar, smoothstep H, \
          Phong 30 receiver. Error: relative RMS over the receivers against the exact integral \
-         of the same spherical lights (steradian_reference::sh::hvl). The Lambert table has 5 \
-         bands, so its rows at 7 and 9 bands are its 5-band figures.</p>\
+         of the same spherical lights (steradian_reference::sh::hvl). The Lambert receiver's \
+         table has 9 bands here (the committed one has the 5 its 5 % target needs).</p>\
          <table><tr><th>M</th><th>bands</th><th>µs per point</th><th>error, Lambert</th><th>error, Phong 30</th></tr>",
     );
     for (m, n, us, e) in &t1.rows {
