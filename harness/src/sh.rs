@@ -307,6 +307,17 @@ pub fn materials() -> [Material; 2] {
 /// The shading of every receiver of `scene` by all its HVLs at `bands` bands (at most the
 /// table's), and the time it took.
 pub fn shade(scene: &HvlScene, mat: &Material, bands: usize) -> (Vec<f64>, Duration) {
+    shade_with(scene, mat, bands, hvl::Horizon::Smoothstep)
+}
+
+/// [`shade`] with the horizon term `horizon` (the paper's smoothstep `H`, or the exact
+/// fraction of the cap above the receiver's horizon).
+pub fn shade_with(
+    scene: &HvlScene,
+    mat: &Material,
+    bands: usize,
+    horizon: hvl::Horizon,
+) -> (Vec<f64>, Duration) {
     let n = bands.min(mat.table.bands());
     let em = hvl::lambert_emission(0.8);
     let v3 = |a: [f64; 3]| Vec3::new(a[0] as f32, a[1] as f32, a[2] as f32);
@@ -339,8 +350,7 @@ pub fn shade(scene: &HvlScene, mat: &Material, bands: usize) -> (Vec<f64>, Durat
                     .iter()
                     .map(|h| {
                         f64::from(
-                            hvl::contribution(h, &em, &rx, hvl::Horizon::Smoothstep, &mut scratch)
-                                .expect("shapes"),
+                            hvl::contribution(h, &em, &rx, horizon, &mut scratch).expect("shapes"),
                         )
                     })
                     .sum::<f64>()

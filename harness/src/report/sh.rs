@@ -277,6 +277,9 @@ fn cap_rows(opts: &Options) -> Vec<(usize, f64, f64)> {
 /// Table 1: `[side][bands]` → (µs per shading point, error per material).
 struct Table1 {
     rows: Vec<(usize, usize, f64, [f64; 2])>,
+    /// The error per material (Lambert, Phong 30) at the last row's HVL count and band
+    /// limit with the smoothstep `H` and with the exact horizon fraction.
+    horizon: [[f64; 2]; 2],
 }
 
 fn table1(opts: &Options) -> Table1 {
@@ -304,7 +307,19 @@ fn table1(opts: &Options) -> Table1 {
             rows.push((side * side, n, us, errs));
         }
     }
-    Table1 { rows }
+    // The horizon term: the paper's smoothstep against the exact fraction of the cap above
+    // the receiver's horizon, at the largest HVL count and band limit.
+    let side = HVL_SIDES[HVL_SIDES.len() - 1];
+    let n = HVL_BANDS[HVL_BANDS.len() - 1];
+    let scene = study::hvl_scene(side);
+    let horizon = [hvl::Horizon::Smoothstep, hvl::Horizon::Exact].map(|h| {
+        core::array::from_fn(|k| {
+            let m = &mats[k];
+            let (got, _) = study::shade_with(&scene, m, n, h);
+            study::rel_rms(&got, &study::shade_exact(&scene, &m.model))
+        })
+    });
+    Table1 { rows, horizon }
 }
 
 /// One row of the HVL speed table: bands, ns per contribution scalar, SIMD, wgpu (upload
@@ -703,6 +718,19 @@ pub fn section(opts: &Options) -> Result<Section, Box<dyn Error>> {
             "HVL: {m} lights at {n} bands: {us:.1} µs per point, error {:.3} (Lambert) {:.3} (Phong 30)",
             e[0], e[1]
         )?;
+        let [s, x] = t1.horizon;
+        writeln!(
+            html,
+            "<p>The horizon term at M = {m}, {n} bands: error with the smoothstep H {:.4} \
+             (Lambert) and {:.4} (Phong 30); with the exact fraction of the cap above the \
+             receiver's horizon instead, {:.4} and {:.4}.</p>",
+            s[0], s[1], x[0], x[1]
+        )?;
+        writeln!(
+            summary,
+            "HVL horizon term at {m} lights, {n} bands: smoothstep {:.4} / {:.4}, exact {:.4} / {:.4} (Lambert / Phong 30)",
+            s[0], s[1], x[0], x[1]
+        )?;
     }
     html.push_str(
         "<h3>HVL contributions per second</h3><p>One contribution (eq. 19–22: the cap toward \
@@ -810,6 +838,10 @@ pub fn section(opts: &Options) -> Result<Section, Box<dyn Error>> {
         "hvl_table1": t1.rows.iter().map(|(m, n, us, e)| json!({
             "hvls": m, "bands": n, "us_per_point": us, "error_lambert": e[0], "error_phong30": e[1],
         })).collect::<Vec<_>>(),
+        "hvl_horizon": {
+            "smoothstep": {"error_lambert": t1.horizon[0][0], "error_phong30": t1.horizon[0][1]},
+            "exact": {"error_lambert": t1.horizon[1][0], "error_phong30": t1.horizon[1][1]},
+        },
         "brdf_tables": brdf.iter().map(|r| json!({
             "material": r.name, "bands": r.bands, "views": r.samples, "bytes": r.bytes,
             "band_limits": [3, 5, 7, 9, 11, 14],
