@@ -1,6 +1,6 @@
 //! Spherical harmonics on arbitrary bits: the SIMD evaluation equals the scalar one bit for
 //! bit for any direction (NaN, ±∞, subnormal components included) at 1–32 bands (the
-//! straight-line code and the loop); every value is finite for every finite non-zero
+//! straight-line code and the loop, in a padded pass and in whole ones); every value is finite for every finite non-zero
 //! direction; the cap coefficients are finite for any finite direction and any half-angle
 //! in `[0, π]` (an error outside, never a panic); the irradiance at a finite normal is
 //! finite for coefficients below `1e30` in magnitude, the SH of a direction or arbitrary
@@ -140,12 +140,22 @@ pub fn check(data: &[u8]) {
         }
     }
     steradian_simd::sh::eval_slices(&x, &y, &z, bands, &mut cols).expect("valid shapes");
+    // The four directions twice: eight columns, one whole pass of eight lanes (AVX-512) or
+    // two of four, where four alone are a padded tail.
+    let twice = |v: &[f32]| -> Vec<f32> { v.iter().chain(v).copied().collect() };
+    let mut cols8 = vec![0.0f32; n * 8];
+    steradian_simd::sh::eval_slices(&twice(&x), &twice(&y), &twice(&z), bands, &mut cols8)
+        .expect("valid shapes");
     let mut one = vec![0.0f32; n];
     for (i, d) in dirs.iter().enumerate() {
         sh::eval_into(*d, bands, &mut one).expect("valid band count");
         for k in 0..n {
             let (a, b) = (cols[k * 4 + i], one[k]);
             assert!(same_bits(a, b), "{d} k {k}: {a} vs {b}");
+            for j in [i, i + 4] {
+                let a = cols8[k * 8 + j];
+                assert!(same_bits(a, b), "{d} of eight, lane {j} k {k}: {a} vs {b}");
+            }
         }
         if d.is_finite() {
             assert!(one.iter().all(|v| v.is_finite()), "{d}: non-finite SH");
