@@ -388,29 +388,34 @@ pub fn measure(opts: &Options) -> Result<SatResults, Box<dyn Error>> {
     // The loads alone, the same entries in the same order: the floor of this layout.
     let sums = view.sums();
     let cold_plan = load_plan(&view, qs);
-    // Scalar, SIMD and the floor take turns, so that the host's bursts of interference
-    // slow them alike and the ratios between them hold.
-    let cold = median_times_in_turns(reps, 3, |k| match k {
-        0 => {
-            for (o, q) in out.iter_mut().zip(qs) {
-                *o = view.box_sum(q[0], q[1], q[2], q[3]);
+    // Scalar (contestant 0), SIMD (1) and the floor (2) on the boxes `qs` (columns `c`,
+    // plan `plan`), `out` written by the first two.
+    let contest = |k: usize, qs: &[[f32; 4]], c: &Columns, plan: &[[u32; 6]], out: &mut [f32]| {
+        match k {
+            0 => {
+                for (o, q) in out.iter_mut().zip(qs) {
+                    *o = view.box_sum(q[0], q[1], q[2], q[3]);
+                }
             }
-            black_box(&out);
-        }
-        1 => {
-            steradian_simd::rsl::sat::box_sum_slices(
+            1 => steradian_simd::rsl::sat::box_sum_slices(
                 &view,
-                cols.col(0),
-                cols.col(1),
-                cols.col(2),
-                cols.col(3),
-                &mut simd_out,
-            );
-            black_box(&simd_out);
+                c.col(0),
+                c.col(1),
+                c.col(2),
+                c.col(3),
+                out,
+            ),
+            _ => {
+                black_box(sum_loads(sums, black_box(plan)));
+            }
         }
-        _ => {
-            black_box(sum_loads(sums, black_box(&cold_plan)));
-        }
+        black_box(&*out);
+    };
+    // The three take turns, so that the host's bursts of interference slow them alike and
+    // the ratios between them hold.
+    let cold = median_times_in_turns(reps, 3, |k| {
+        let o = if k == 1 { &mut simd_out } else { &mut out };
+        contest(k, qs, &cols, &cold_plan, o);
     });
     let (scalar, simd, cold_loads) = (cold[0], cold[1], cold[2]);
     let scalar_out = out.clone();
@@ -455,28 +460,7 @@ pub fn measure(opts: &Options) -> Result<SatResults, Box<dyn Error>> {
     let warm_plan = load_plan(&view, warm);
     let warm_t = median_times_in_turns(reps, 3, |k| {
         for _ in 0..rounds {
-            match k {
-                0 => {
-                    for (o, q) in wout.iter_mut().zip(warm) {
-                        *o = view.box_sum(q[0], q[1], q[2], q[3]);
-                    }
-                    black_box(&wout);
-                }
-                1 => {
-                    steradian_simd::rsl::sat::box_sum_slices(
-                        &view,
-                        wc.col(0),
-                        wc.col(1),
-                        wc.col(2),
-                        wc.col(3),
-                        &mut wout,
-                    );
-                    black_box(&wout);
-                }
-                _ => {
-                    black_box(sum_loads(sums, black_box(&warm_plan)));
-                }
-            }
+            contest(k, warm, &wc, &warm_plan, &mut wout);
         }
     });
     let (warm_scalar, warm_simd, warm_loads) = (warm_t[0], warm_t[1], warm_t[2]);
