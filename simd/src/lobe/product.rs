@@ -133,11 +133,12 @@ fn one_pm_cos<W: Lanes>(sn: W, cs: W) -> (W, W) {
     (hz.select(one, omc), hz.select(one, opc))
 }
 
-/// One lane of the scalar kernel's `arcs` (see there): the doubled angle from an axis or a
-/// horizon to a peak, for exponents `(a, b)` of the two lobes, `r = ±(b − a)` and `c4 = ±c`
-/// as that lane has them; everything times `n = a + b`. Returns `(sn, cs, 1 − cos, 1 + cos)`.
+/// Two lanes of the scalar kernel's `arcs` (see there) that share their exponents: the
+/// doubled angles from an axis (`c4 = c`) or from a horizon (`c4 = −c`) to a peak, for
+/// exponents `(a, b)` of the two lobes, with `r = b − a` and with `r = −(b − a)`;
+/// everything times `n = a + b`. Returns `(sn, cs, 1 − cos, 1 + cos)` for each sign.
 #[inline(always)]
-fn arc<W: Lanes>(a: W, b: W, r: W, c4: W, c: W, s: W) -> (W, W, W, W) {
+fn arc_pair<W: Lanes>(a: W, b: W, c4: W, c: W, s: W) -> [(W, W, W, W); 2] {
     let (zero, one) = (W::splat(0.0), W::splat(1.0));
     // The scalar `pow2_range`: an exact power of two that keeps n² normal.
     let p = |e: i32| W::splat(f32::from_bits(((127 + e) as u32) << 23));
@@ -146,23 +147,28 @@ fn arc<W: Lanes>(a: W, b: W, r: W, c4: W, c: W, s: W) -> (W, W, W, W) {
         n.lt(p(-60)).select(p(100), p(64)),
         n.gt(p(20)).select(n.gt(p(60)).select(p(-100), p(-40)), one),
     );
-    let (a, b, r) = (a * k, b * k, r * k);
+    let (a, b) = (a * k, b * k);
     let n = a + b;
     let ab4 = W::splat(4.0) * a * b;
     let cy = (n * n * (c * c) + ab4 * (s * s)).sqrt();
-    let rc = -r * c4;
-    let den = cy + rc;
-    let pos = den.gt(zero).select(s * ab4 / den, zero);
-    let sn = rc.ge(zero).select(pos, s * (cy - rc));
-    let cs = c4 * cy - r * s * s;
+    // |(sn, cs)| = n·(c² + s²) for either sign.
     let h = n * (c * c + s * s);
-    let d = h + cs.abs();
-    let (small, big) = (sn * sn / (h * d), d / h);
-    let cpos = cs.ge(zero);
     let hz = h.eq(zero);
-    let omc = hz.select(one, cpos.select(small, big));
-    let opc = hz.select(one, cpos.select(big, small));
-    (sn, cs, omc, opc)
+    let lane = |r: W| {
+        let rc = -r * c4;
+        let den = cy + rc;
+        let pos = den.gt(zero).select(s * ab4 / den, zero);
+        let sn = rc.ge(zero).select(pos, s * (cy - rc));
+        let cs = c4 * cy - r * s * s;
+        let d = h + cs.abs();
+        let (small, big) = (sn * sn / (h * d), d / h);
+        let cpos = cs.ge(zero);
+        let omc = hz.select(one, cpos.select(small, big));
+        let opc = hz.select(one, cpos.select(big, small));
+        (sn, cs, omc, opc)
+    };
+    let r = b - a;
+    [lane(r), lane(-r)]
 }
 
 /// The scalar kernel's logarithm of a lane of `arcs`: `½·ln(1 + x)`, `x = −p/2`, where
@@ -194,9 +200,7 @@ fn baseline<W: Lanes>(e1: W, e2: W, c: W, s: W) -> Baseline<W> {
     let (zero, one, half) = (W::splat(0.0), W::splat(1.0), W::splat(0.5));
     // The peak of the product (exponents e1, e2), for e1 + e2 > 0: lanes 2 and 3 of the
     // scalar kernel's arcs.
-    let r = e2 - e1;
-    let (_, _, omc1, opc1) = arc(e1, e2, r, c, c, s);
-    let (_, _, omc2, opc2) = arc(e1, e2, -r, c, c, s);
+    let [(_, _, omc1, opc1), (_, _, omc2, opc2)] = arc_pair(e1, e2, c, c, s);
     let term = |e: W, omc: W, opc: W| e.eq(zero).select(zero, e * ln_half(omc, opc));
     let curv = |e: W, opc: W| e.eq(zero).select(zero, e * W::splat(2.0) / opc);
     let peak_ln = term(e1, omc1, opc1) + term(e2, omc2, opc2);
@@ -214,9 +218,7 @@ fn baseline<W: Lanes>(e1: W, e2: W, c: W, s: W) -> Baseline<W> {
     // Laplace in the logit variable around the peak of sin^(e1+1)·sin^(e2+1): lanes 0 and
     // 1 of the arcs (their sines times f1 + f2).
     let (f1, f2) = (e1 + one, e2 + one);
-    let r = f2 - f1;
-    let (snx, csx, omcx, opcx) = arc(f1, f2, -r, -c, c, s);
-    let (sny, csy, omcy, opcy) = arc(f1, f2, r, -c, c, s);
+    let [(sny, csy, omcy, opcy), (snx, csx, omcx, opcx)] = arc_pair(f1, f2, -c, c, s);
     // Lanes near α = π go to the scalar kernel (see `MIN_WIDE_SIN`).
     let min_sn = W::splat(MIN_WIDE_SIN) * (f1 + f2);
     let redo = !(snx.ge(min_sn) & sny.ge(min_sn));
