@@ -43,24 +43,21 @@ fn pow2_range(n: f32) -> f32 {
     return 1.0;
 }
 
-// One lane of the scalar kernel's `arcs`: the doubled angle from an axis (c4 = c) or a
-// horizon (c4 = −c) to the peak for exponents (a0, b0), r = sign·(b − a), everything
-// times n = a + b (prescaled by pow2_range); returns (sn, cs, 1 − cos, 1 + cos).
-fn arc(a0: f32, b0: f32, sign: f32, c4: f32, c: f32, s: f32) -> vec4<f32> {
-    let k = pow2_range(a0 + b0);
-    let a = a0 * k;
-    let b = b0 * k;
-    let n = a + b;
-    let r = (b - a) * sign;
-    let ab4 = 4.0 * a * b;
-    let cy = sqrt(n * n * (c * c) + ab4 * (s * s));
+// Two lanes of the scalar kernel's `arcs` that share their exponents (a0, b0): the doubled
+// angles from an axis (c4 = c) or a horizon (c4 = −c) to the peak, with r = b − a (first)
+// and r = −(b − a) (second), everything times n = a + b (prescaled by pow2_range); each
+// (sn, cs, 1 − cos, 1 + cos).
+struct ArcPair {
+    plus: vec4<f32>,
+    minus: vec4<f32>,
+}
+
+fn arc_lane(r: f32, c4: f32, s: f32, cy: f32, ab4: f32, h: f32) -> vec4<f32> {
     let rc = -r * c4;
     let den = cy + rc;
     let pos = select(0.0, s * ab4 / den, den > 0.0);
     let sn = select(s * (cy - rc), pos, rc >= 0.0);
     let cs = c4 * cy - r * s * s;
-    // |(sn, cs)| = n·(c² + s²).
-    let h = n * (c * c + s * s);
     if (h == 0.0) {
         return vec4<f32>(sn, cs, 1.0, 1.0);
     }
@@ -71,6 +68,19 @@ fn arc(a0: f32, b0: f32, sign: f32, c4: f32, c: f32, s: f32) -> vec4<f32> {
         return vec4<f32>(sn, cs, small, big);
     }
     return vec4<f32>(sn, cs, big, small);
+}
+
+fn arc_pair(a0: f32, b0: f32, c4: f32, c: f32, s: f32) -> ArcPair {
+    let k = pow2_range(a0 + b0);
+    let a = a0 * k;
+    let b = b0 * k;
+    let n = a + b;
+    let ab4 = 4.0 * a * b;
+    let cy = sqrt(n * n * (c * c) + ab4 * (s * s));
+    // |(sn, cs)| = n·(c² + s²) for either sign.
+    let h = n * (c * c + s * s);
+    let r = b - a;
+    return ArcPair(arc_lane(r, c4, s, cy, ab4, h), arc_lane(-r, c4, s, cy, ab4, h));
 }
 
 // e^(−g): the scalar `exp_neg_small` (degree-6 Taylor polynomial where |g| <= 1/4).
@@ -193,8 +203,9 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     var st: f32;
     var ln_peak = 0.0;
     if (e1 + e2 > 0.0) {
-        let p1 = arc(e1, e2, 1.0, c, c, s);
-        let p2 = arc(e1, e2, -1.0, c, c, s);
+        let pp = arc_pair(e1, e2, c, c, s);
+        let p1 = pp.plus;
+        let p2 = pp.minus;
         if (e1 != 0.0) {
             ln_peak = ln_peak + e1 * ln_cos_half(p1.z, p1.w);
         }
@@ -214,8 +225,9 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     // 1 of the arcs).
     let f1 = e1 + 1.0;
     let f2 = e2 + 1.0;
-    let px = arc(f1, f2, -1.0, -c, c, s);
-    let py = arc(f1, f2, 1.0, -c, c, s);
+    let ph = arc_pair(f1, f2, -c, c, s);
+    let px = ph.minus;
+    let py = ph.plus;
     let x = 0.5 * atan2_(px.x, px.y);
     let y = 0.5 * atan2_(py.x, py.y);
     if (!(x > 0.0 && y > 0.0)) {
