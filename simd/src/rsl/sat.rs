@@ -4,19 +4,20 @@
 //! the ordering and clipping of the corners with comparisons and selects, `floor`, the
 //! exact fractions, the sixteen table reads (eight adjacent pairs per lane, staged by a
 //! plain loop over the lanes, which the compiler turns into gathers where the target has
-//! them: `wide` has none), the 27 exact `i64` subtractions in `i64x8`, the nine
+//! them: `wide` has none; every index is clipped into the table, so they need no mask), the 27 exact `i64` subtractions in `i64x8`, the nine
 //! `i64 → f64` conversions, the `f64` combination in the scalar kernel's order (no fused
 //! multiply-add), the scaling by the quantum and the one rounding to `f32`. So every lane
 //! is **bit-identical** to the scalar kernel, NaN lanes included (NaN exactly where a
 //! corner is NaN).
 
 use steradian_core::rsl::sat::{SatView, square_half_side};
-use wide::{f32x8, f64x8, i64x8};
+use wide::{f32x8, f64x8, i32x8, i64x8};
 
 use crate::lanes::{ColumnKernel, Lanes, drive};
 
 /// One axis of 8 boxes, lane-wise `steradian_core::rsl::sat::axis`: `(I0, a0, I1, a1)`, the
-/// indices as exact integers in `f32` lanes. Lanes must not be NaN.
+/// indices as exact integers in `f32` lanes. A NaN lane gives NaN indices and fractions
+/// (`entries` clips the indices into the table).
 #[inline(always)]
 fn axis(c0: f32x8, c1: f32x8, n: usize) -> (f32x8, f32x8, f32x8, f32x8) {
     let nf = f32x8::splat(n as f32);
@@ -37,7 +38,7 @@ fn axis(c0: f32x8, c1: f32x8, n: usize) -> (f32x8, f32x8, f32x8, f32x8) {
     (i0, lo - i0, i1, hi - i1)
 }
 
-/// Exact integers `0 ≤ x < 2²⁴` in `f32` lanes as indices.
+/// Exact integers `0 ≤ x < 2²⁴` in `f32` lanes as indices (the integer path: no NaN lane).
 #[inline(always)]
 fn indices(x: f32x8) -> [usize; 8] {
     x.trunc_int().to_array().map(|i| i as u32 as usize)
@@ -51,25 +52,21 @@ fn widen(x: f32x8) -> f64x8 {
 /// Eight box sums: lane `k` is `sat.box_sum(u0[k], v0[k], u1[k], v1[k])`, bit-identical.
 #[inline]
 pub fn box_sum(sat: &SatView<'_>, u0: f32x8, v0: f32x8, u1: f32x8, v1: f32x8) -> f32x8 {
-    let nan = u0.is_nan() | v0.is_nan() | u1.is_nan() | v1.is_nan();
-    // NaN lanes compute a harmless box and are replaced by NaN at the end.
-    let zero = f32x8::splat(0.0);
-    let (u0, v0, u1, v1) = (
-        nan.select(zero, u0),
-        nan.select(zero, v0),
-        nan.select(zero, u1),
-        nan.select(zero, v1),
-    );
+    // No NaN test, as in the scalar kernel: a NaN corner flows through `axis` without harm
+    // (its indices are clipped into the table, as in `entries`) and makes its
+    // fraction NaN, so its lane takes the fractional path and every term of the final
+    // combination carries that fraction: the lane is NaN.
     let (i0, a0, i1, a1) = axis(u0, u1, sat.width());
     let (j0, b0, j1, b1) = axis(v0, v1, sat.height());
-    let (i0, i1, j0, j1) = (indices(i0), indices(i1), indices(j0), indices(j1));
     let q = f64x8::splat(sat.quantum());
-    // The fractions are 0 or positive (never −0, never NaN here): a sum of them is 0
-    // exactly when all are.
+    // The fractions are 0 or positive (never −0), or NaN: a sum of them is 0 exactly when
+    // all are 0.
+    let zero = f32x8::splat(0.0);
     let integer = (a0 + a1 + b0 + b1).simd_eq(zero).all();
-    let out = if integer {
+    if integer {
         // Every lane has integer corners: the scalar kernel's four-lookup path in every
         // lane (the same `i64` box sum, conversion, scaling and rounding).
+        let (i0, i1, j0, j1) = (indices(i0), indices(i1), indices(j0), indices(j1));
         let (sums, w1) = (sat.sums(), sat.width() + 1);
         let at = |k: usize| sums.get(k).copied().unwrap_or(0);
         let s: [i64; 8] = core::array::from_fn(|k| {
@@ -81,67 +78,100 @@ pub fn box_sum(sat: &SatView<'_>, u0: f32x8, v0: f32x8, u1: f32x8, v1: f32x8) ->
         let r = (i64x8::new(s).round_float() * q).to_array();
         f32x8::new(r.map(|v| v as f32))
     } else {
-        // The scalar kernel's sixteen entries per lane (`SatView::integer_terms`: rows `J0`,
-        // `J1`, and `J + 1` where the fraction is non-zero, else `J` again; columns `I0`,
-        // `I0 + 1`, `I1`, `I1 + 1`; a row past the table reads as zeros), loaded lane-wise
-        // into sixteen `i64x8`, then its 27 wrapping subtractions lane-wise
-        // (wrapping `i64` arithmetic is exact modulo 2⁶⁴: the scalar terms, bit for bit).
-        let (sums, w1, wl) = (sat.sums(), sat.width() + 1, sat.width() - 1);
-        // Row offsets, a row past the table at `len` (every entry of it then reads as 0,
-        // as the scalar kernel's row-wise check gives; rows are at most `height` for a
-        // valid view, so this only keeps the index arithmetic from overflowing).
-        let h1 = sat.height() + 1;
-        let (bl0, bl1) = (b0.to_array(), b1.to_array());
-        let off = |l: usize| l.min(h1) * w1;
-        // Rows `J0`, `J1`, and `J + 1` where the fraction is non-zero, else `J` again
-        // (`J < 2²⁴`: exact integers from `f32` lanes, so `J + 1` does not overflow).
-        let mut rows = [[0usize; 8]; 4];
-        for k in 0..8 {
-            let (a, b) = (j0[k], j1[k]);
-            rows[0][k] = off(a);
-            rows[1][k] = off(b);
-            rows[2][k] = off(a + usize::from(bl0[k] != 0.0));
-            rows[3][k] = off(b + usize::from(bl1[k] != 0.0));
-        }
-        let cols: [[usize; 8]; 2] = [i0.map(|i| i.min(wl)), i1.map(|i| i.min(wl))];
-        // st[4·row + col][lane], each row's two column pairs read as pairs (a column index
-        // is at most `width − 1`, so a pair never leaves its row; a row past the table reads
-        // as zeros).
-        let mut st = [[0i64; 8]; 16];
-        for k in 0..8 {
-            for (r, rk) in rows.iter().enumerate() {
-                for (c, ck) in cols.iter().enumerate() {
-                    let at = rk[k] + ck[k];
-                    let [x, y] = match sums.get(at..at + 2) {
-                        Some(&[x, y]) => [x, y],
-                        _ => [0, 0],
-                    };
-                    st[4 * r + 2 * c][k] = x;
-                    st[4 * r + 2 * c + 1][k] = y;
-                }
+        fractional(sat, [i0, i1, j0, j1], [a0, a1, b0, b1])
+    }
+}
+
+/// The fractional path of [`box_sum`]: the scalar kernel's sixteen entries per lane
+/// (`SatView::integer_terms`: rows `J0`, `J1`, and `J + 1` where the fraction is non-zero,
+/// else `J` again; columns `I0`, `I0 + 1`, `I1`, `I1 + 1`), loaded lane-wise into sixteen `i64x8`, then its 27 wrapping subtractions
+/// lane-wise (wrapping `i64` arithmetic is exact modulo 2⁶⁴: the scalar terms, bit for
+/// bit) and the `f64` combination.
+#[inline(always)]
+fn fractional(sat: &SatView<'_>, ij: [f32x8; 4], [a0, a1, b0, b1]: [f32x8; 4]) -> f32x8 {
+    let (rows, cols) = entries(sat, ij, [b0, b1]);
+    combine(sat, &gather(sat.sums(), &rows, &cols), [a0, a1, b0, b1])
+}
+
+/// Row offsets (`J0`, `J1`, `J0 + 1` or `J0`, `J1 + 1` or `J1`) and columns (`I0`, `I1`)
+/// of the sixteen entries of [`fractional`], from the indices `I0, I1, J0, J1` of [`axis`]
+/// (exact integers `0 ≤ I ≤ width − 1`, `0 ≤ J ≤ height − 1` in `f32` lanes, or NaN), in
+/// `i32` lanes: sides are at most `MAX_SIDE` = 2²⁴, so `width + 1` fits and a row offset
+/// `J·(width + 1)` is exact in the widening multiply's `i64`. A NaN lane's indices are
+/// clipped into the table: its result is NaN whatever it reads.
+#[inline(always)]
+fn entries(
+    sat: &SatView<'_>,
+    [i0, i1, j0, j1]: [f32x8; 4],
+    [b0, b1]: [f32x8; 2],
+) -> ([[usize; 8]; 4], [[usize; 8]; 2]) {
+    let side = |n: usize| i32x8::splat(n as i32);
+    let (h, w1, wl) = (
+        side(sat.height()),
+        side(sat.width() + 1),
+        side(sat.width() - 1),
+    );
+    let index = |x: f32x8| x.fast_trunc_int().max(i32x8::ZERO);
+    let usizes = |x: i64x8| x.to_array().map(|v| v as usize);
+    // Rows are at most `height` (`J ≤ height − 1`, so `J + 1 ≤ height`).
+    let row = |j: i32x8| usizes(j.min(h).widening_mul(w1));
+    // `J + 1` where the fraction is non-zero, else `J` again (exact: `J + 1 ≤ 2²⁴`).
+    let next = |j: f32x8, b: f32x8| j + b.simd_ne(f32x8::ZERO).select(f32x8::ONE, f32x8::ZERO);
+    let rows = [
+        row(index(j0)),
+        row(index(j1)),
+        row(index(next(j0, b0))),
+        row(index(next(j1, b1))),
+    ];
+    let col = |i: f32x8| index(i).min(wl).to_array().map(|v| v as u32 as usize);
+    (rows, [col(i0), col(i1)])
+}
+
+/// `st[4·row + col][lane]`: each row's two column pairs read as pairs. A column index is at
+/// most `width − 1` and a row at most `height`, so a pair starts at most two entries before
+/// the end of the table; the `min` only lets the compiler see it (no bounds check, no mask).
+#[inline(always)]
+fn gather(sums: &[i64], rows: &[[usize; 8]; 4], cols: &[[usize; 8]; 2]) -> [[i64; 8]; 16] {
+    let mut st = [[0i64; 8]; 16];
+    // A valid view's table holds at least 2 × 2 entries.
+    let Some(last) = sums.len().checked_sub(2) else {
+        return st;
+    };
+    for k in 0..8 {
+        for (r, rk) in rows.iter().enumerate() {
+            for (c, ck) in cols.iter().enumerate() {
+                let at = (rk[k] + ck[k]).min(last);
+                st[4 * r + 2 * c][k] = sums[at];
+                st[4 * r + 2 * c + 1][k] = sums[at + 1];
             }
         }
-        let row = |r: usize| -> [i64x8; 4] { core::array::from_fn(|c| i64x8::new(st[4 * r + c])) };
-        let (r0, r1, r0p, r1p) = (row(0), row(1), row(2), row(3));
-        let d = |l: [i64x8; 4], m: [i64x8; 4]| -> [i64x8; 3] {
-            [
-                (m[2] - m[0]) - (l[2] - l[0]),
-                (m[3] - m[2]) - (l[3] - l[2]),
-                (m[1] - m[0]) - (l[1] - l[0]),
-            ]
-        };
-        let [t0, t1, t2] = [d(r0, r1), d(r1, r1p), d(r0, r0p)];
-        let t = [
-            t0[0], t0[1], t0[2], t1[0], t1[1], t1[2], t2[0], t2[1], t2[2],
-        ];
-        let f = |n: usize| t[n].round_float();
-        let (a0, a1, b0, b1) = (widen(a0), widen(a1), widen(b0), widen(b1));
-        let x = |n: usize| (f(n) + a1 * f(n + 1)) - a0 * f(n + 2);
-        let (x_box, x_top, x_bottom) = (x(0), x(3), x(6));
-        let r = (((x_box + b1 * x_top) - b0 * x_bottom) * q).to_array();
-        f32x8::new(r.map(|v| v as f32))
+    }
+    st
+}
+
+/// The scalar kernel's 27 subtractions, nine conversions and `f64` combination on the
+/// entries `st` of [`gather`], in its order, then the quantum and the rounding to `f32`.
+#[inline(always)]
+fn combine(sat: &SatView<'_>, st: &[[i64; 8]; 16], [a0, a1, b0, b1]: [f32x8; 4]) -> f32x8 {
+    let row = |r: usize| -> [i64x8; 4] { core::array::from_fn(|c| i64x8::new(st[4 * r + c])) };
+    let (r0, r1, r0p, r1p) = (row(0), row(1), row(2), row(3));
+    let d = |l: [i64x8; 4], m: [i64x8; 4]| -> [i64x8; 3] {
+        [
+            (m[2] - m[0]) - (l[2] - l[0]),
+            (m[3] - m[2]) - (l[3] - l[2]),
+            (m[1] - m[0]) - (l[1] - l[0]),
+        ]
     };
-    nan.select(f32x8::splat(f32::NAN), out)
+    let [t0, t1, t2] = [d(r0, r1), d(r1, r1p), d(r0, r0p)];
+    let t = [
+        t0[0], t0[1], t0[2], t1[0], t1[1], t1[2], t2[0], t2[1], t2[2],
+    ];
+    let f = |n: usize| t[n].round_float();
+    let (a0, a1, b0, b1) = (widen(a0), widen(a1), widen(b0), widen(b1));
+    let x = |n: usize| (f(n) + a1 * f(n + 1)) - a0 * f(n + 2);
+    let (x_box, x_top, x_bottom) = (x(0), x(3), x(6));
+    let r = (((x_box + b1 * x_top) - b0 * x_bottom) * f64x8::splat(sat.quantum())).to_array();
+    f32x8::new(r.map(|v| v as f32))
 }
 
 /// Eight squares: lane `k` is `sat.square(Vec2::new(cx[k], cy[k]), r[k])`, bit-identical.
