@@ -172,6 +172,66 @@ fn hvl(c: &mut Criterion) {
             },
         );
     }
+    // A Lambertian receiver (zonal coefficients) summing 64 HVLs around it: the scalar
+    // `contribution_zonal` one at a time against the SIMD `contributions_zonal`.
+    let mut rng = 0x9e37_79b9_u32;
+    let mut u = move || {
+        rng ^= rng << 13;
+        rng ^= rng >> 17;
+        rng ^= rng << 5;
+        rng as f32 / u32::MAX as f32
+    };
+    let hvls: Vec<hvl::Hvl> = (0..64)
+        .filter_map(|_| {
+            let p = Vec3::new(4.0 * u() - 2.0, 4.0 * u() - 2.0, 0.2 + 2.0 * u());
+            let n = Vec3::new(u() - 0.5, u() - 0.5, -1.0).normalize();
+            hvl::Hvl::new(p, n, Vec3::Z, 0.05 + 0.2 * u(), 1.0).ok()
+        })
+        .collect();
+    g.throughput(Throughput::Elements(hvls.len() as u64));
+    for bands in [3usize, 5] {
+        let zonal: Vec<f32> = (0..bands).map(|l| 1.0 / (1.0 + l as f32)).collect();
+        let zrx = hvl::ZonalReceiver {
+            point: Vec3::ZERO,
+            frame,
+            coeffs: &zonal,
+        };
+        let mut scratch = vec![0.0f32; bands];
+        let mut out = vec![0.0f32; hvls.len()];
+        g.bench_with_input(
+            BenchmarkId::new("zonal-64/scalar", bands),
+            &bands,
+            |b, _| {
+                b.iter(|| {
+                    for (h, o) in hvls.iter().zip(out.iter_mut()) {
+                        *o = hvl::contribution_zonal(
+                            black_box(h),
+                            &em,
+                            &zrx,
+                            hvl::Horizon::Smoothstep,
+                            &mut scratch,
+                        )
+                        .unwrap();
+                    }
+                    black_box(&out);
+                })
+            },
+        );
+        g.bench_with_input(BenchmarkId::new("zonal-64/simd", bands), &bands, |b, _| {
+            b.iter(|| {
+                steradian_simd::sh::hvl::contributions_zonal(
+                    black_box(&hvls),
+                    &em,
+                    &zrx,
+                    hvl::Horizon::Smoothstep,
+                    &mut scratch,
+                    &mut out,
+                )
+                .unwrap();
+                black_box(&out);
+            })
+        });
+    }
     g.finish();
 }
 

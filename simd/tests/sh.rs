@@ -655,3 +655,152 @@ fn hvl_lanes_equal_the_scalar_kernel() {
     assert!(f(&[h; 2], &[0.0; 1], &rx, hz, &mut s4, &mut [0.0; 1]).is_err());
     assert!(f(&[h; 2], &[0.0; 1], &rx, hz, &mut s4, &mut [0.0; 2]).is_ok());
 }
+
+/// `contributions_zonal` against the scalar `contribution_zonal`: within
+/// `ZONAL_TOL·P·Ē·(G/H)·S̄` (the scalar kernel's terms in absolute value, without the
+/// horizon factor; settled lanes and the exact horizon bit for bit). Returns the worst
+/// error over that scale and the worst relative error where `H > 0.05` and no sum cancels
+/// by more than half.
+fn check_zonal(
+    hvls: &[sh::hvl::Hvl],
+    emission: &[f32],
+    rx: &sh::hvl::ZonalReceiver<'_>,
+) -> (f64, f64) {
+    use steradian_simd::sh::hvl::ZONAL_TOL;
+    let ne = sh::bands_of(emission.len()).expect("square");
+    let n = rx.coeffs.len();
+    let mut scratch = vec![0.0f32; n.max(ne * ne)];
+    let (mut worst_scale, mut worst_rel) = (0.0f64, 0.0f64);
+    for horizon in [sh::hvl::Horizon::Smoothstep, sh::hvl::Horizon::Exact] {
+        let mut out = vec![0.0f32; hvls.len()];
+        steradian_simd::sh::hvl::contributions_zonal(
+            hvls,
+            emission,
+            rx,
+            horizon,
+            &mut scratch,
+            &mut out,
+        )
+        .expect("valid shapes");
+        for (j, h) in hvls.iter().enumerate() {
+            let want =
+                sh::hvl::contribution_zonal(h, emission, rx, horizon, &mut scratch).expect("valid");
+            let got = out[j];
+            let prepared = sh::hvl::prepare(h, rx.point, &rx.frame, horizon);
+            let sh::hvl::Prepared::Lit {
+                emit_dir,
+                cap_axis,
+                half_angle,
+                power,
+                g,
+            } = prepared
+            else {
+                assert!(same(got, want), "HVL {j} {horizon:?}: {got} vs {want}");
+                continue;
+            };
+            if horizon == sh::hvl::Horizon::Exact {
+                assert!(same(got, want), "HVL {j} {horizon:?}: {got} vs {want}");
+                continue;
+            }
+            // The terms, in f64.
+            let hs = f64::from(sh::hvl::horizon_smoothstep(cap_axis.z, half_angle));
+            let mut y = vec![0.0f32; (ne * ne).max(n)];
+            sh::eval_into(emit_dir, ne, &mut y).expect("shape");
+            let (e_abs, e) = emission
+                .iter()
+                .zip(&y)
+                .fold((0.0f64, 0.0f64), |(a, s), (f, y)| {
+                    (a + f64::from(f * y).abs(), s + f64::from(f * y))
+                });
+            sh::eval_zonal_into(cap_axis, n, &mut y).expect("shape");
+            let (mut s_abs, mut s) = (0.0f64, 0.0f64);
+            sh::cap::band_scales(half_angle, n, |l, k| {
+                let t = f64::from(rx.coeffs[l]) * f64::from(y[l]) * k;
+                (s_abs, s) = (s_abs + t.abs(), s + t);
+            });
+            let scale = f64::from(power).abs() * e_abs * (f64::from(g) / hs) * s_abs;
+            let err = (f64::from(got) - f64::from(want)).abs();
+            assert!(
+                err <= f64::from(ZONAL_TOL) * scale,
+                "HVL {j}: {got} vs {want} (H = {hs}, scale {scale:e})"
+            );
+            if scale > 0.0 {
+                worst_scale = worst_scale.max(err / scale);
+            }
+            if hs > 0.05 && 2.0 * s.abs() > s_abs && 2.0 * e.abs() > e_abs {
+                worst_rel = worst_rel.max(err / f64::from(want).abs());
+            }
+        }
+    }
+    (worst_scale, worst_rel)
+}
+
+#[test]
+fn hvl_zonal_lanes_are_within_their_bound_of_the_scalar_kernel() {
+    let mut rng = Rng(0x5a7);
+    let (mut rel, mut abs) = (0.0f64, 0.0f64);
+    for (n, ne) in [(1usize, 1usize), (3, 1), (5, 1), (5, 3), (9, 1), (20, 2)] {
+        let coeffs: Vec<f32> = (0..n).map(|_| rng.range(-0.5, 1.0)).collect();
+        let emission: Vec<f32> = (0..ne * ne).map(|_| rng.range(0.0, 0.5)).collect();
+        let normal = rng.dir();
+        let rx = sh::hvl::ZonalReceiver {
+            point: Vec3::new(0.1, -0.2, 0.3),
+            frame: sh::brdf::view_frame(normal, (normal + rng.dir() * 0.5).normalize())
+                .expect("frame"),
+            coeffs: &coeffs,
+        };
+        for len in LENGTHS {
+            // Distances 0.05–20 and radii 0.001–2: caps from 5e-5 rad to a half-space, some
+            // facing away, some below the horizon, some across it.
+            let hvls: Vec<sh::hvl::Hvl> = (0..len.min(400))
+                .map(|_| {
+                    let p = rx.point + rng.dir() * rng.log_range(0.05, 20.0);
+                    sh::hvl::Hvl::new(
+                        p,
+                        rng.dir(),
+                        rng.dir(),
+                        rng.log_range(0.001, 2.0),
+                        rng.range(0.0, 5.0),
+                    )
+                    .expect("valid HVL")
+                })
+                .collect();
+            let (r, a) = check_zonal(&hvls, &emission, &rx);
+            (rel, abs) = (rel.max(r), abs.max(a));
+        }
+        // Settled lanes among lit ones in every position: at the receiver, facing away,
+        // infinitely far is not constructible (finite positions), wholly below the horizon.
+        let at_point = sh::hvl::Hvl::new(rx.point, Vec3::Z, Vec3::Z, 0.1, 1.0).expect("valid");
+        let facing =
+            sh::hvl::Hvl::new(rx.point + normal, -normal, Vec3::Z, 0.3, 2.0).expect("valid");
+        let away = sh::hvl::Hvl::new(rx.point + normal, normal, Vec3::Z, 0.3, 2.0).expect("valid");
+        let below =
+            sh::hvl::Hvl::new(rx.point - normal * 3.0, normal, Vec3::Z, 0.3, 2.0).expect("valid");
+        for k in 0..9 {
+            let mut row = vec![
+                at_point, away, below, at_point, away, below, at_point, away, below,
+            ];
+            row[k] = facing;
+            check_zonal(&row, &emission, &rx);
+        }
+    }
+    println!(
+        "zonal HVL lanes: worst error {rel:.2e} of the terms' scale, {abs:.2e} relative where H > 0.05 and no sum cancels by half"
+    );
+    // Shapes: a non-square emission, a short scratch, a short output, nothing at all.
+    let coeffs = [0.5f32; 3];
+    let rx = sh::hvl::ZonalReceiver {
+        point: Vec3::ZERO,
+        frame: sh::brdf::view_frame(Vec3::Z, Vec3::Z).expect("frame"),
+        coeffs: &coeffs,
+    };
+    let h = sh::hvl::Hvl::new(Vec3::Z, -Vec3::Z, Vec3::Z, 0.1, 1.0).expect("valid");
+    let hz = sh::hvl::Horizon::Smoothstep;
+    let f = steradian_simd::sh::hvl::contributions_zonal;
+    let mut s = vec![0.0f32; 3];
+    assert!(f(&[h; 2], &[0.0; 2], &rx, hz, &mut s, &mut [0.0; 2]).is_err());
+    assert!(f(&[h; 2], &[0.0; 1], &rx, hz, &mut s[..2], &mut [0.0; 2]).is_err());
+    assert!(f(&[h; 2], &[0.0; 1], &rx, hz, &mut s, &mut [0.0; 1]).is_err());
+    assert!(f(&[], &[0.0; 1], &rx, hz, &mut s, &mut []).is_ok());
+    assert!(f(&[h; 2], &[0.0; 1], &rx, hz, &mut s, &mut [0.0; 2]).is_ok());
+}

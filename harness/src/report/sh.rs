@@ -324,7 +324,8 @@ fn table1(opts: &Options) -> Table1 {
 
 /// One row of the HVL speed table: bands, ns per contribution scalar, SIMD, wgpu (upload
 /// and read-back included; `None` without an adapter).
-type HvlRow = (usize, f64, f64, Option<f64>);
+/// `(bands, scalar ns, SIMD ns, wgpu ns, zonal scalar ns, zonal SIMD ns)`.
+type HvlRow = (usize, f64, f64, Option<f64>, f64, f64);
 
 /// Per band count (3, 5, 9): ns per HVL contribution, scalar and SIMD (four HVLs per pass),
 /// taking turns, and on wgpu (`wgsl::SH_HVL`, one contribution per invocation), the 400 HVLs of Table 1's scene at its first receiver with the Phong 30
@@ -400,7 +401,50 @@ fn hvl_rows(opts: &Options, gpu: &mut Option<Gpu>) -> Vec<HvlRow> {
                 });
                 ns_per(rows.len(), t)
             });
-            (n, ns_per(count, t[0]), ns_per(count, t[1]), gpu_ns)
+            // The zonal receiver (a Lambertian surface: the `m = 0` entries of the Lambert
+            // table at the same view), scalar and SIMD (eight HVLs per pass) in turns.
+            let nz = n.min(mats[0].table.bands());
+            let mut full = vec![0.0f32; nz * nz];
+            mats[0]
+                .table
+                .lookup_into(brdf::Part::WithCosine, theta, nz, &mut full)
+                .expect("bands within the table");
+            let zonal: Vec<f32> = (0..nz).map(|l| full[l * l + l]).collect();
+            let zrx = hvl::ZonalReceiver {
+                point: v3(p),
+                frame,
+                coeffs: &zonal,
+            };
+            let hz = hvl::Horizon::Smoothstep;
+            let tz = median_times_in_turns(opts.repeats.min(5), 2, |k| {
+                for _ in 0..reps {
+                    if k == 0 {
+                        for (h, o) in scene.hvls.iter().zip(out.iter_mut()) {
+                            *o = hvl::contribution_zonal(h, &em, &zrx, hz, &mut scratch)
+                                .expect("shapes");
+                        }
+                    } else {
+                        steradian_simd::sh::hvl::contributions_zonal(
+                            &scene.hvls,
+                            &em,
+                            &zrx,
+                            hz,
+                            &mut scratch,
+                            &mut out,
+                        )
+                        .expect("shapes");
+                    }
+                    black_box(&out);
+                }
+            });
+            (
+                n,
+                ns_per(count, t[0]),
+                ns_per(count, t[1]),
+                gpu_ns,
+                ns_per(count, tz[0]),
+                ns_per(count, tz[1]),
+            )
         })
         .collect()
 }
@@ -737,22 +781,27 @@ pub fn section(opts: &Options) -> Result<Section, Box<dyn Error>> {
          the HVL projected, rotated and dotted with the receiver's F, the emission F′·Y(−ω)), \
          the 400 HVLs of the M = 400 scene at one Phong 30 receiver, smoothstep H; scalar \
          and SIMD (four HVLs per pass, bit-identical) taking turns; wgpu (wgsl::SH_HVL, one \
-         contribution per invocation, f32, upload and read-back included).</p>\
-         <table><tr><th>bands</th><th>ns, scalar</th><th>ns, SIMD</th><th>ns, wgpu</th><th>SIMD / scalar</th><th>contributions per second (SIMD)</th></tr>",
+         contribution per invocation, f32, upload and read-back included). Zonal: the same \
+         HVLs at a Lambertian receiver (the m = 0 entries of the Lambert table, at most its 5 \
+         bands), contribution_zonal against the SIMD contributions_zonal (eight HVLs per \
+         pass, within ZONAL_TOL), taking turns.</p>\
+         <table><tr><th>bands</th><th>ns, scalar</th><th>ns, SIMD</th><th>ns, wgpu</th><th>SIMD / scalar</th><th>contributions per second (SIMD)</th><th>zonal ns, scalar</th><th>zonal ns, SIMD</th><th>zonal SIMD / scalar</th></tr>",
     );
-    for (n, sc, si, gp) in &hvl_ns {
+    for (n, sc, si, gp, zs, zi) in &hvl_ns {
         writeln!(
             html,
-            "<tr><td>{n}</td><td>{sc:.1}</td><td>{si:.1}</td><td>{}</td><td>{:.2}×</td><td>{:.2e}</td></tr>",
+            "<tr><td>{n}</td><td>{sc:.1}</td><td>{si:.1}</td><td>{}</td><td>{:.2}×</td><td>{:.2e}</td><td>{zs:.1}</td><td>{zi:.1}</td><td>{:.2}×</td></tr>",
             gp.map_or("—".to_string(), |g| format!("{g:.1}")),
             sc / si,
-            1e9 / si
+            1e9 / si,
+            zs / zi
         )?;
         writeln!(
             summary,
-            "HVL contribution at {n} bands: scalar {sc:.1} ns, SIMD {si:.1} ns ({:.2}×), wgpu {}",
+            "HVL contribution at {n} bands: scalar {sc:.1} ns, SIMD {si:.1} ns ({:.2}×), wgpu {}; zonal receiver: scalar {zs:.1} ns, SIMD {zi:.1} ns ({:.2}×)",
             sc / si,
-            gp.map_or("—".to_string(), |g| format!("{g:.1} ns"))
+            gp.map_or("—".to_string(), |g| format!("{g:.1} ns")),
+            zs / zi
         )?;
     }
     html.push_str("</table>");
@@ -834,7 +883,7 @@ pub fn section(opts: &Options) -> Result<Section, Box<dyn Error>> {
             "operator_apply_ns": r.apply_ns, "simd_operator_apply_ns": r.simd_apply_ns,
         })).collect::<Vec<_>>(),
         "cap_ns": caps.iter().map(|(n, ns, simd)| json!({"bands": n, "ns": ns, "simd_ns": simd})).collect::<Vec<_>>(),
-        "hvl_ns": hvl_ns.iter().map(|(n, sc, si, gp)| json!({"bands": n, "scalar_ns": sc, "simd_ns": si, "wgpu_ns": gp})).collect::<Vec<_>>(),
+        "hvl_ns": hvl_ns.iter().map(|(n, sc, si, gp, zs, zi)| json!({"bands": n, "scalar_ns": sc, "simd_ns": si, "wgpu_ns": gp, "zonal_scalar_ns": zs, "zonal_simd_ns": zi})).collect::<Vec<_>>(),
         "hvl_table1": t1.rows.iter().map(|(m, n, us, e)| json!({
             "hvls": m, "bands": n, "us_per_point": us, "error_lambert": e[0], "error_phong30": e[1],
         })).collect::<Vec<_>>(),
