@@ -1,5 +1,6 @@
 //! Whole shading points of the built-in `cluster` scene (64 occluder spheres): the `lobes`
-//! method with the quadtree mask and with one lobe per occluder, against one path-traced
+//! method with the quadtree mask (scalar, and its SIMD path eight points at a time) and with
+//! one lobe per occluder, against one path-traced
 //! sample of the same pixels (direct light) as the baseline of the same run; one thread.
 //! (One sample is not equal error: the report's `scenes` section compares at equal error.)
 //!
@@ -50,6 +51,20 @@ fn scenes(c: &mut Criterion) {
             })
         });
     }
+    // The SIMD path of `steradian render`: eight points per `shade_x8`.
+    let batch: Vec<ShadingPoint> = pts.iter().map(|(_, p)| *p).collect();
+    let o = lobes::Options::default();
+    g.bench_function("lobes-mask-simd", |b| {
+        let mut out = [[0.0; 3]; 8];
+        b.iter(|| {
+            let mut counts = Default::default();
+            for ps in batch.chunks(8) {
+                let out = &mut out[..ps.len()];
+                lobes::shade_x8(&scene, black_box(ps), &o, &mut counts, out);
+                black_box(&*out);
+            }
+        })
+    });
     g.bench_function("path-1-sample", |b| {
         let mut rng = Rng::new(1);
         b.iter(|| {

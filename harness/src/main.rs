@@ -94,8 +94,8 @@ enum Command {
         /// No progress bar.
         #[arg(long)]
         quiet: bool,
-        /// Shade with the scalar kernels (rsl shades eight points at a time with its SIMD
-        /// kernel otherwise; the other methods are scalar).
+        /// Shade with the scalar kernels (otherwise rsl and lobes shade eight points at a
+        /// time with SIMD kernels, and hvl sums each receiver's HVLs with them).
         #[arg(long)]
         scalar: bool,
         /// Shade on the wgpu backend (rsl; hvl its diffuse indirect light; an error without an adapter).

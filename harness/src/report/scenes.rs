@@ -8,7 +8,10 @@
 //! whose reference is the noisiest per sample), direct light for `lobes` and `cluster` and
 //! one bounce for `room`; the path tracer's curve is the same tracer with other seeds at
 //! [`PATH_SPP`] samples. The default point of `lobes` and `hvl` is what `steradian render`
-//! plans at the default target error (`planned`). The `lobes` method's curve is its
+//! plans at the default target error (`planned`); `lobes` and `hvl` render with their SIMD
+//! paths (the default of `steradian render`), their scalar paths at the default setting
+//! variants. The
+//! `lobes` method's curve is its
 //! pruning threshold at the planned quadtree depth and every other depth at the planned
 //! threshold, with the L2 cap fit and
 //! one lobe per occluder (instead of the default energy-preserving fit and quadtree mask)
@@ -185,16 +188,29 @@ fn mask_depth(v: lobes::Visibility) -> u32 {
 fn lobes_settings(scene: &Scene) -> (Vec<Setting<'_>>, Vec<Setting<'_>>) {
     let px = scene.camera.pixels() as f64;
     let d = planned(scene, render::Method::Lobes).map_or_else(lobes::Options::default, |p| p.lobes);
-    let mk = move |label: String, o: lobes::Options, default: bool| Setting {
+    // Renders with the SIMD path, `steradian render`'s default; the scalar path at the
+    // default setting is a variant.
+    let mk_with = move |label: String, o: lobes::Options, default: bool, simd: bool| Setting {
         label,
         render: Box::new(move || {
-            let (img, c) = lobes::render(scene, &o, &ProgressBar::hidden());
+            let hidden = ProgressBar::hidden();
+            let (img, c) = if simd {
+                lobes::render_simd(scene, &o, &hidden)
+            } else {
+                lobes::render(scene, &o, &hidden)
+            };
             (img, Some(c.computed as f64 / px))
         }),
         default,
         build_seconds: None,
-        per_core: default.then_some("scalar"),
+        per_core: if simd {
+            default.then_some("simd")
+        } else {
+            Some("scalar")
+        },
     };
+    let mk =
+        move |label: String, o: lobes::Options, default: bool| mk_with(label, o, default, true);
     let depth = mask_depth(d.visibility);
     // The curve's thresholds and the planned one (`--target-error`/10).
     let mut thresholds = THRESHOLDS.to_vec();
@@ -226,6 +242,12 @@ fn lobes_settings(scene: &Scene) -> (Vec<Setting<'_>>, Vec<Setting<'_>>) {
         }
     }
     let variants = vec![
+        mk_with(
+            format!("t = {:.0e}, depth {depth}, scalar kernel", d.threshold),
+            d,
+            false,
+            false,
+        ),
         mk(
             format!("L2 cap fit, t = {:.0e}, depth {depth}", d.threshold),
             lobes::Options {
@@ -251,12 +273,18 @@ fn hvl_settings<'a>(
     gpu: Option<&'a std::sync::Mutex<crate::backend::gpu::Gpu>>,
 ) -> (Vec<Setting<'a>>, Vec<Setting<'a>>) {
     let d = planned(scene, render::Method::Hvl).map_or_else(hvl::Options::default, |p| p.hvl);
+    // The planned options sum the HVLs with the SIMD kernels (`steradian render`'s default);
+    // the scalar kernels at the default setting are a variant.
     let mk = move |label: String, o: hvl::Options, default: bool| Setting {
         label,
         render: Box::new(move || (hvl::render(scene, &o, &ProgressBar::hidden()).0, None)),
         default,
         build_seconds: None,
-        per_core: default.then_some("scalar"),
+        per_core: if o.simd {
+            default.then_some("simd")
+        } else {
+            Some("scalar")
+        },
     };
     let curve = HVL_SIDES
         .iter()
@@ -271,6 +299,14 @@ fn hvl_settings<'a>(
     let px = scene.camera.pixels() as f64;
     let direct = d.direct;
     let mut variants = vec![
+        mk(
+            format!(
+                "{} HVLs, scalar kernels",
+                6 * d.side * d.side * scene.lights.len()
+            ),
+            hvl::Options { simd: false, ..d },
+            false,
+        ),
         mk(
             format!(
                 "{} HVLs, no HVL visibility (the paper)",
@@ -466,9 +502,10 @@ fn measure_scene(
         .iter()
         .map(|st| measure(st).map(|(p, _)| p))
         .collect::<Result<Vec<_>, _>>()?;
-    // Throughput on one core: the default setting (scalar) and, for `rsl`, its SIMD
-    // variant and its wgpu variant (one core building the visibility tables, the adapter
-    // shading), each the best of two renders in a one-thread pool.
+    // Throughput on one core: the default setting (`lobes` and `hvl`: SIMD, `rsl` scalar),
+    // the kernel variants (`lobes` and `hvl` scalar, `rsl` SIMD) and `rsl`'s wgpu variant (one core
+    // building the visibility tables, the adapter shading), each the best of two renders in
+    // a one-thread pool.
     let surface_points = (0..scene.camera.height)
         .flat_map(|j| (0..scene.camera.width).map(move |i| (i, j)))
         .filter(|&(i, j)| matches!(scene.see(&scene.camera.centre_ray(i, j)), Seen::Surface(_)))

@@ -49,6 +49,11 @@ pub struct Options {
     /// SH bands of the receivers' diffuse part: the first `bands` of the committed Lambert
     /// table (at most its 5; planned by [`choose_bands`]).
     pub bands: usize,
+    /// Sum each receiver's HVLs with the SIMD kernels (`steradian_simd::sh::hvl`: the
+    /// diffuse part by `contributions_zonal`, eight HVLs at a time, within its `ZONAL_TOL`
+    /// of the scalar kernel; the glossy parts by `contributions`, four at a time, bit for
+    /// bit); `false` the scalar kernels, one HVL at a time.
+    pub simd: bool,
 }
 
 impl Default for Options {
@@ -59,6 +64,7 @@ impl Default for Options {
             visibility: true,
             glossy: true,
             bands: brdf::lambert().bands(),
+            simd: true,
         }
     }
 }
@@ -167,6 +173,10 @@ pub struct Scratch {
     sh: Vec<f32>,
     /// `F` of each glossy part of the current receiver, `n²` each.
     glossy: Vec<Vec<f32>>,
+    /// The SIMD path's per-HVL contributions: the diffuse part's, then each glossy part's.
+    diffuse_c: Vec<f32>,
+    glossy_c: Vec<Vec<f32>>,
+    sh4: Vec<[f32; 4]>,
 }
 
 impl Default for Scratch {
@@ -177,6 +187,9 @@ impl Default for Scratch {
             zonal: vec![0.0; n],
             sh: vec![0.0; n * n],
             glossy: Vec::new(),
+            diffuse_c: Vec::new(),
+            glossy_c: Vec::new(),
+            sh4: Vec::new(),
         }
     }
 }
@@ -352,6 +365,9 @@ fn indirect_parts(
         zonal,
         sh,
         glossy: gcoeffs,
+        diffuse_c,
+        glossy_c,
+        sh4,
     } = scratch;
     let Some((frame, theta, n)) = lambert_zonal(p, o.bands, coeffs, zonal) else {
         return [0.0; 3];
@@ -378,12 +394,47 @@ fn indirect_parts(
         coeffs: &zonal[..n],
     };
     let emission = core_hvl::lambert_emission(1.0);
+    // The SIMD path: every HVL's share of each part first, batched.
+    let batched = o.simd && !hvls.is_empty();
+    if batched {
+        let lights: Vec<core_hvl::Hvl> = hvls.iter().map(|h| h.hvl).collect();
+        let horizon = core_hvl::Horizon::Smoothstep;
+        diffuse_c.resize(hvls.len(), 0.0);
+        if !diffuse
+            || steradian_simd::sh::hvl::contributions_zonal(
+                &lights, &emission, &rx, horizon, sh, diffuse_c,
+            )
+            .is_err()
+        {
+            diffuse_c.fill(0.0);
+        }
+        glossy_c.resize_with(parts.len(), Vec::new);
+        for ((f, on), out) in gcoeffs.iter().zip(&live).zip(glossy_c.iter_mut()) {
+            out.resize(hvls.len(), 0.0);
+            let grx = core_hvl::Receiver {
+                point: p.x.as_vec3(),
+                frame,
+                coeffs: f,
+            };
+            sh4.resize(f.len().max(1), [0.0; 4]);
+            if !*on
+                || steradian_simd::sh::hvl::contributions(
+                    &lights, &emission, &grx, horizon, sh4, out,
+                )
+                .is_err()
+            {
+                out.fill(0.0);
+            }
+        }
+    }
     let origin = path::offset(p.x, p.n);
     let mut acc = [0.0f64; 3];
     let mut gacc = [[0.0f64; 3]; super::material::MAX_LOBES];
     let mut shares = [0.0f64; super::material::MAX_LOBES];
-    for h in hvls {
-        let c = if diffuse {
+    for (j, h) in hvls.iter().enumerate() {
+        let c = if batched {
+            f64::from(diffuse_c[j].max(0.0))
+        } else if diffuse {
             core_hvl::contribution_zonal(&h.hvl, &emission, &rx, core_hvl::Horizon::Smoothstep, sh)
                 .unwrap_or(0.0)
                 .max(0.0) as f64
@@ -391,9 +442,12 @@ fn indirect_parts(
             0.0
         };
         let mut any = c > 0.0;
-        for ((f, on), share) in gcoeffs.iter().zip(&live).zip(shares.iter_mut()) {
+        for (k, ((f, on), share)) in gcoeffs.iter().zip(&live).zip(shares.iter_mut()).enumerate() {
             *share = 0.0;
-            if *on {
+            if batched {
+                *share = f64::from(glossy_c.get(k).map_or(0.0, |g| g[j]).max(0.0));
+                any |= *share > 0.0;
+            } else if *on {
                 let grx = core_hvl::Receiver {
                     point: p.x.as_vec3(),
                     frame,

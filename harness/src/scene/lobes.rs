@@ -35,7 +35,7 @@ use steradian_core::lobe::sum::{
 };
 
 use super::image::Image;
-use super::{Kind, Rgb, Scene, ShadingPoint, Shape, render_centres};
+use super::{Kind, Rgb, Scene, ShadingPoint, Shape, render_centres, render_centres_x8};
 
 /// How visibility becomes lobes.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -86,108 +86,213 @@ fn f32v(v: DVec3) -> Vec3 {
 
 /// The reflected radiance at a shading point.
 pub fn shade(scene: &Scene, p: &ShadingPoint, o: &Options, counts: &mut ProductCounts) -> Rgb {
-    let ShadingPoint {
-        object: self_id,
-        material: mi,
-        x,
-        n,
-        wo,
-    } = *p;
-    let mat = &scene.materials[mi];
-    let diffuse = mat.diffuse();
-    let glossy = mat.lobes(n, wo);
-    let nf = f32v(n);
+    let rx = Receiver::of(scene, p);
     let mut out = [0.0; 3];
-    'lights: for (li, light) in scene.lights.iter().enumerate() {
-        for obj in &scene.objects {
-            if let Shape::Plane { point, normal } = obj.shape {
-                let sx = normal.dot(x - point);
-                let sl = normal.dot(light.center - point);
-                if sx.abs() > 1e-9 * (1.0 + x.abs().max_element()) && sx * sl < 0.0 {
-                    continue 'lights;
-                }
-            }
-        }
-        let rel = light.center - x;
-        let Ok(cap) = SphericalCap::from_sphere(Vec3::ZERO, f32v(rel), light.radius as f32) else {
+    for li in 0..scene.lights.len() {
+        let Some(cap) = light_cap(scene, p, li) else {
             continue;
         };
         let mut l = LobeSum::<1>::new();
         l.push_cap(&cap, 1.0, o.fit);
-        let l = light_with_cosine(&l, nf, Cosine::WithLight, counts);
-        let mut vis = LobeVec {
-            constant: 1.0,
-            lobes: Vec::new(),
-        };
-        let d_light = rel.length();
-        let (s_light, a_light) = ((light.radius / d_light).min(1.0), rel / d_light);
-        let c_light = (1.0 - s_light * s_light).max(0.0).sqrt();
-        let mut occluders = Vec::new();
-        for (id, obj) in scene.objects.iter().enumerate() {
-            if id == self_id || obj.kind == Kind::Light(li) {
-                continue;
-            }
-            let Shape::Sphere { center, radius } = obj.shape else {
-                continue;
-            };
-            let rc = center - x;
-            let d2 = rc.length_squared();
-            if d2 >= d_light * d_light {
-                continue;
-            }
-            // The caps overlap iff the angle θ between their axes is below α_l + α_o:
-            // cos θ > cos α_l·cos α_o − sin α_l·sin α_o (both angles in [0, π/2],
-            // sin α_o = r/d), times d: rc·a_l > cos α_l·√(d² − r²) − sin α_l·r. One square
-            // root and no inverse trigonometry for a sphere that is culled.
-            let (tangent, r_in) = if d2 > radius * radius {
-                ((d2 - radius * radius).sqrt(), radius)
-            } else {
-                (0.0, d2.sqrt())
-            };
-            if rc.dot(a_light) <= c_light * tangent - s_light * r_in {
-                continue;
-            }
-            let Ok(oc) = SphericalCap::from_sphere(Vec3::ZERO, f32v(rc), radius as f32) else {
-                continue;
-            };
-            occluders.push(oc);
-        }
-        match o.visibility {
-            Visibility::PerOccluder => {
-                vis.lobes
-                    .extend(occluders.iter().map(|oc| oc.lobe(-1.0, o.fit)));
-            }
-            Visibility::Mask { depth, leaves } => {
-                let dist = mask::dist_of(cap.half_angle());
-                mask::shadow_leaves(&cap, &occluders, depth, leaves, |leaf, d| {
-                    let w = mask::weight(&mask::WEIGHTS, dist, d);
-                    vis.lobes.push(leaf.lobe(-w, o.fit));
-                });
-            }
-        }
-        let unoccluded = LobeSum::<1>::unoccluded();
-        let mut chain = |r: &LobeSum<1>| -> f64 {
-            let u = triple(r, &l, &unoccluded, 0.0, counts);
-            if vis.lobes.is_empty() {
-                return u as f64;
-            }
-            triple(r, &l, &vis, o.threshold * u.abs(), counts) as f64
-        };
-        let i_d = chain(&LobeSum::with_constant(1.0 / std::f32::consts::PI));
-        let mut acc = diffuse.map(|d| d * i_d);
-        for g in glossy.iter() {
-            let lobe = CosineLobe::saturating(f32v(g.axis), 1.0, g.exponent as f32);
-            let r = LobeSum::<1>::from_lobes(0.0, &[lobe]);
-            let i_g = chain(&r);
-            for (a, s) in acc.iter_mut().zip(g.scale) {
-                *a += s * i_g;
-            }
-        }
-        for c in 0..3 {
-            out[c] += light.radiance[c] * acc[c].max(0.0);
-        }
+        let l = light_with_cosine(&l, rx.normal, Cosine::WithLight, counts);
+        shade_light(scene, p, &rx, li, &cap, &l, o, counts, &mut out);
     }
     out
+}
+
+/// [`shade`] of up to eight points at once (`out[k]` for `points[k]`), the product of each
+/// light's lobe with the cosine by the SIMD kernel
+/// ([`steradian_simd::lobe::product::product_x8`], eight points per product) and the rest
+/// lane by lane as [`shade`] does it. Each radiance is within the SIMD product's bounds of
+/// [`shade`]'s (its axis is the scalar kernel's bit for bit; its scale and exponent are within
+/// a few `f32` ulps per unit of their logarithms), which the harness test
+/// `lobes_simd_render_matches_the_scalar_one` measures on the built-in scenes.
+///
+/// # Panics
+/// If `points` and `out` differ in length or hold more than eight.
+pub fn shade_x8(
+    scene: &Scene,
+    points: &[ShadingPoint],
+    o: &Options,
+    counts: &mut ProductCounts,
+    out: &mut [Rgb],
+) {
+    use steradian_core::lobe::product::{ProductFit, ProductTable};
+    use steradian_simd::batch::LobeX8;
+    use steradian_simd::lobe::product::product_x8;
+    assert!(points.len() == out.len() && points.len() <= 8);
+    let rxs: Vec<Receiver> = points.iter().map(|p| Receiver::of(scene, p)).collect();
+    out.fill([0.0; 3]);
+    let table = ProductTable::builtin();
+    for li in 0..scene.lights.len() {
+        let caps: Vec<Option<SphericalCap>> =
+            points.iter().map(|p| light_cap(scene, p, li)).collect();
+        // `lobe_product`'s operands, as unit lobes (a pad where a lane has no light).
+        let pad = CosineLobe::saturating(Vec3::Z, 0.0, 0.0);
+        let lobes: Vec<CosineLobe> = caps
+            .iter()
+            .map(|c| c.map_or(pad, |c| c.lobe(1.0, o.fit)))
+            .collect();
+        let unit = |l: &CosineLobe| CosineLobe::saturating(l.axis(), 1.0, l.exponent());
+        let a = LobeX8::from_slice(&lobes.iter().map(unit).collect::<Vec<_>>());
+        let cosines: Vec<CosineLobe> = rxs
+            .iter()
+            .map(|rx| CosineLobe::saturating(rx.normal, 1.0, 1.0))
+            .collect();
+        let b = LobeX8::from_slice(&cosines);
+        let products = product_x8(&table, ProductFit::ExactIntegral, &a, &b).to_array();
+        for (k, cap) in caps.iter().enumerate() {
+            let Some(cap) = cap else { continue };
+            // `lobe_product`: the unit product scaled by the light lobe's scale (the cosine's
+            // is 1); `push_times_cosine`'s count.
+            let q = products[k];
+            let lp = CosineLobe::saturating(
+                q.axis(),
+                q.scale() * (lobes[k].scale() * 1.0),
+                q.exponent(),
+            );
+            counts.computed += 1;
+            let l = LobeSum::<1>::from_lobes(0.0, &[lp]);
+            shade_light(
+                scene,
+                &points[k],
+                &rxs[k],
+                li,
+                cap,
+                &l,
+                o,
+                counts,
+                &mut out[k],
+            );
+        }
+    }
+}
+
+/// What [`shade`] needs of a point for every light: its material's diffuse RGB and glossy
+/// lobes at its view, and its normal in `f32`.
+struct Receiver {
+    diffuse: Rgb,
+    glossy: super::material::ViewLobes,
+    normal: Vec3,
+}
+
+impl Receiver {
+    fn of(scene: &Scene, p: &ShadingPoint) -> Receiver {
+        let mat = &scene.materials[p.material];
+        Receiver {
+            diffuse: mat.diffuse(),
+            glossy: mat.lobes(p.n, p.wo),
+            normal: f32v(p.n),
+        }
+    }
+}
+
+/// The cap light `li` subtends at `p`, or `None` where it lights nothing there: hidden by a
+/// plane (its centre on the other side of a plane than `p`, `p` not on that plane), or no
+/// cap (`p` inside the light).
+fn light_cap(scene: &Scene, p: &ShadingPoint, li: usize) -> Option<SphericalCap> {
+    let (x, light) = (p.x, &scene.lights[li]);
+    for obj in &scene.objects {
+        if let Shape::Plane { point, normal } = obj.shape {
+            let sx = normal.dot(x - point);
+            let sl = normal.dot(light.center - point);
+            if sx.abs() > 1e-9 * (1.0 + x.abs().max_element()) && sx * sl < 0.0 {
+                return None;
+            }
+        }
+    }
+    SphericalCap::from_sphere(Vec3::ZERO, f32v(light.center - x), light.radius as f32).ok()
+}
+
+/// Light `li`'s radiance at `p` added to `out`: its cap `cap`, its lobe times the cosine
+/// `l`, the visibility of its occluders (module docs) and the receiver's chains.
+#[allow(clippy::too_many_arguments)]
+fn shade_light(
+    scene: &Scene,
+    p: &ShadingPoint,
+    rx: &Receiver,
+    li: usize,
+    cap: &SphericalCap,
+    l: &LobeSum<1>,
+    o: &Options,
+    counts: &mut ProductCounts,
+    out: &mut Rgb,
+) {
+    let (self_id, x, light) = (p.object, p.x, &scene.lights[li]);
+    let mut vis = LobeVec {
+        constant: 1.0,
+        lobes: Vec::new(),
+    };
+    let rel = light.center - x;
+    let d_light = rel.length();
+    let (s_light, a_light) = ((light.radius / d_light).min(1.0), rel / d_light);
+    let c_light = (1.0 - s_light * s_light).max(0.0).sqrt();
+    let mut occluders = Vec::new();
+    for (id, obj) in scene.objects.iter().enumerate() {
+        if id == self_id || obj.kind == Kind::Light(li) {
+            continue;
+        }
+        let Shape::Sphere { center, radius } = obj.shape else {
+            continue;
+        };
+        let rc = center - x;
+        let d2 = rc.length_squared();
+        if d2 >= d_light * d_light {
+            continue;
+        }
+        // The caps overlap iff the angle θ between their axes is below α_l + α_o:
+        // cos θ > cos α_l·cos α_o − sin α_l·sin α_o (both angles in [0, π/2],
+        // sin α_o = r/d), times d: rc·a_l > cos α_l·√(d² − r²) − sin α_l·r. One square
+        // root and no inverse trigonometry for a sphere that is culled.
+        let (tangent, r_in) = if d2 > radius * radius {
+            ((d2 - radius * radius).sqrt(), radius)
+        } else {
+            (0.0, d2.sqrt())
+        };
+        if rc.dot(a_light) <= c_light * tangent - s_light * r_in {
+            continue;
+        }
+        let Ok(oc) = SphericalCap::from_sphere(Vec3::ZERO, f32v(rc), radius as f32) else {
+            continue;
+        };
+        occluders.push(oc);
+    }
+    match o.visibility {
+        Visibility::PerOccluder => {
+            vis.lobes
+                .extend(occluders.iter().map(|oc| oc.lobe(-1.0, o.fit)));
+        }
+        // No occluder, no shadow leaf: the mask is not walked.
+        Visibility::Mask { .. } if occluders.is_empty() => {}
+        Visibility::Mask { depth, leaves } => {
+            let dist = mask::dist_of(cap.half_angle());
+            mask::shadow_leaves(cap, &occluders, depth, leaves, |leaf, d| {
+                let w = mask::weight(&mask::WEIGHTS, dist, d);
+                vis.lobes.push(leaf.lobe(-w, o.fit));
+            });
+        }
+    }
+    let unoccluded = LobeSum::<1>::unoccluded();
+    let mut chain = |r: &LobeSum<1>| -> f64 {
+        let u = triple(r, l, &unoccluded, 0.0, counts);
+        if vis.lobes.is_empty() {
+            return u as f64;
+        }
+        triple(r, l, &vis, o.threshold * u.abs(), counts) as f64
+    };
+    let i_d = chain(&LobeSum::with_constant(1.0 / std::f32::consts::PI));
+    let mut acc = rx.diffuse.map(|d| d * i_d);
+    for g in rx.glossy.iter() {
+        let lobe = CosineLobe::saturating(f32v(g.axis), 1.0, g.exponent as f32);
+        let r = LobeSum::<1>::from_lobes(0.0, &[lobe]);
+        let i_g = chain(&r);
+        for (a, s) in acc.iter_mut().zip(g.scale) {
+            *a += s * i_g;
+        }
+    }
+    for c in 0..3 {
+        out[c] += light.radiance[c] * acc[c].max(0.0);
+    }
 }
 
 /// What [`choose_depth`] chose and what it measured.
@@ -238,6 +343,18 @@ pub fn choose_depth(scene: &Scene, o: &Options, target: f64) -> DepthChoice {
 pub fn render(scene: &Scene, o: &Options, bar: &ProgressBar) -> (Image, ProductCounts) {
     let (img, rows) = render_centres(scene, bar, ProductCounts::default, |counts, p| {
         shade(scene, p, o, counts)
+    });
+    let mut total = ProductCounts::default();
+    for c in rows {
+        total += c;
+    }
+    (img, total)
+}
+
+/// [`render`] with the points of each row shaded eight at a time by [`shade_x8`].
+pub fn render_simd(scene: &Scene, o: &Options, bar: &ProgressBar) -> (Image, ProductCounts) {
+    let (img, rows) = render_centres_x8(scene, bar, ProductCounts::default, |counts, ps, out| {
+        shade_x8(scene, ps, o, counts, out)
     });
     let mut total = ProductCounts::default();
     for c in rows {

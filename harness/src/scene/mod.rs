@@ -347,6 +347,54 @@ pub fn render_centres<S: Send>(
     (img, states)
 }
 
+/// [`render_centres`] with the surface points of a row shaded eight at a time by
+/// `shade(state, points, out)` (`out[k]` for `points[k]`; the last batch of a row may be
+/// shorter).
+pub fn render_centres_x8<S: Send>(
+    scene: &Scene,
+    bar: &ProgressBar,
+    new_state: impl Fn() -> S + Sync,
+    shade: impl Fn(&mut S, &[ShadingPoint], &mut [Rgb]) + Sync,
+) -> (Image, Vec<S>) {
+    let cam = scene.camera;
+    let (w, h) = (cam.width as usize, cam.height as usize);
+    let rows: Vec<(Vec<Rgb>, S)> = (0..h)
+        .into_par_iter()
+        .map(|j| {
+            let mut state = new_state();
+            let mut row = vec![[0.0; 3]; w];
+            let mut pixels = Vec::with_capacity(w);
+            let mut points = Vec::with_capacity(w);
+            for (i, px) in row.iter_mut().enumerate() {
+                match scene.see(&cam.centre_ray(i as u32, j as u32)) {
+                    Seen::Radiance(l) => *px = l,
+                    Seen::Surface(p) => {
+                        pixels.push(i);
+                        points.push(p);
+                    }
+                }
+            }
+            let mut out = [[0.0; 3]; 8];
+            for (is, ps) in pixels.chunks(8).zip(points.chunks(8)) {
+                let out = &mut out[..ps.len()];
+                shade(&mut state, ps, out);
+                for (&i, v) in is.iter().zip(out.iter()) {
+                    row[i] = *v;
+                }
+            }
+            bar.inc(1);
+            (row, state)
+        })
+        .collect();
+    let mut img = Image::new(w, h);
+    let mut states = Vec::with_capacity(h);
+    for (j, (row, state)) in rows.into_iter().enumerate() {
+        img.data[j * w..(j + 1) * w].copy_from_slice(&row);
+        states.push(state);
+    }
+    (img, states)
+}
+
 /// The share of `--target-error` each planned setting may add to a render ([`rsl::choose_k`],
 /// [`hvl::choose_side`], [`lobes::choose_depth`]; the pruning threshold takes a tenth). The
 /// methods' own models take most of the rest (on `cluster` the lobe model alone errs by

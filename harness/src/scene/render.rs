@@ -70,9 +70,9 @@ pub struct Options {
     pub seed: u64,
     /// Hide the progress bar.
     pub quiet: bool,
-    /// Shade with the scalar kernels (`rsl` uses its SIMD kernel otherwise).
+    /// Shade with the scalar kernels (`rsl`, `lobes` and `hvl` use SIMD kernels otherwise).
     pub scalar: bool,
-    /// Shade on the wgpu backend (`rsl` only; an error without an adapter).
+    /// Shade on the wgpu backend (`rsl` and `hvl`; an error without an adapter).
     pub gpu: bool,
 }
 
@@ -136,7 +136,7 @@ pub struct Plan {
     pub rsl: super::rsl::Options,
 }
 
-/// The `rsl` kernel the options select.
+/// The kernel the options select.
 fn kernel_name(o: &Options) -> &'static str {
     if o.gpu {
         "wgpu"
@@ -353,7 +353,38 @@ pub fn plan(scene: &Scene, o: &Options) -> Result<Plan, String> {
                 ),
             });
             if o.method == Method::Hvl {
+                p.push(PlanItem {
+                    item: "kernel".into(),
+                    value: json!(kernel_name(o)),
+                    reason: if o.gpu {
+                        "--gpu: the diffuse indirect light by the WGSL HVL sum, one receiver \
+                         per invocation; the direct light and glossy parts on the CPU"
+                            .into()
+                    } else if o.scalar {
+                        "--scalar: every HVL by the scalar kernels, one at a time".into()
+                    } else {
+                        "each receiver's HVLs by the SIMD kernels: the diffuse part eight at a \
+                         time, the glossy parts four at a time (--scalar for the scalar ones, \
+                         --gpu for wgpu)"
+                            .into()
+                    },
+                });
+            }
+            if o.method == Method::Lobes {
+                p.push(PlanItem {
+                    item: "kernel".into(),
+                    value: json!(kernel_name(o)),
+                    reason: if o.scalar {
+                        "--scalar: every product by the scalar kernel, one point at a time".into()
+                    } else {
+                        "each light's lobe times the cosine by the SIMD product kernel, eight                          points at a time, the rest lane by lane (--scalar for the scalar one)"
+                            .into()
+                    },
+                });
+            }
+            if o.method == Method::Hvl {
                 hv.direct = lo;
+                hv.simd = !o.scalar;
                 // The glossy tables first (generated once per process): the side's probes
                 // shade with them, and their time is the method's, reported here.
                 let t = Instant::now();
@@ -470,12 +501,17 @@ pub fn run(scene: &Scene, scene_name: &str, o: &Options, plan: &Plan) -> Result<
             (out.image, Some(out.stderr), json!({}))
         }
         Method::Lobes => {
-            let (img, counts) = lobes::render(scene, &plan.lobes, &b);
+            let (img, counts) = if o.scalar {
+                lobes::render(scene, &plan.lobes, &b)
+            } else {
+                lobes::render_simd(scene, &plan.lobes, &b)
+            };
             let px = scene.camera.pixels().max(1) as f64;
             (
                 img,
                 None,
                 json!({
+                    "kernel": kernel_name(o),
                     "products_computed_per_pixel": counts.computed as f64 / px,
                     "products_pruned_per_pixel": counts.pruned as f64 / px,
                     "products_skipped_per_pixel": (counts.skipped_bound + counts.skipped_chain) as f64 / px,
@@ -516,7 +552,7 @@ pub fn run(scene: &Scene, scene_name: &str, o: &Options, plan: &Plan) -> Result<
             (
                 img,
                 None,
-                json!({ "hvls": count, "kernel": if o.gpu { "wgpu" } else { "scalar" } }),
+                json!({ "hvls": count, "kernel": kernel_name(o) }),
             )
         }
     };
