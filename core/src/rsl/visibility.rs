@@ -138,6 +138,19 @@ fn cap_fn_at(cap: &SphericalCap, w: Vec3) -> f32 {
     cap.one_minus_cos() - 0.5 * d.dot(d)
 }
 
+/// A bound on `|f(x) − f(c)|` for a cap's `f` over the points `x` within `h` of `c` (disk
+/// coordinates), `w = unmap(c)`: `f = a·ω − cos α` for unit `ω` (`½|a − ω|² = 1 − a·ω`), and
+/// along a segment of length `h` the direction moves by an arc of at most `LIP_CAP·h` (the
+/// map's largest stretch), so the angle `θ` to the axis moves by at most that and
+/// `|cos θ_x − cos θ_c| ≤ LIP_CAP·h·max |sin θ| ≤ LIP_CAP·h·min(1, sin θ_c + LIP_CAP·h)`
+/// (`|sin|` is 1-Lipschitz), with `sin θ_c = |a × ω|`. For a small cap near its boundary this
+/// is about `sin α` times the plain `LIP_CAP·h`, so far fewer squares near it are split.
+#[inline]
+fn cap_bound(cap: &SphericalCap, w: Vec3, h: f32) -> f32 {
+    let reach = LIP_CAP * h;
+    reach * (cap.axis().cross(w).length() + reach).min(1.0)
+}
+
 /// Whether the disk point `p` (any point of the square `[−1, 1]²`) is visible.
 #[inline]
 pub fn is_visible(caps: &[SphericalCap], p: Vec2, outside: Outside) -> bool {
@@ -193,7 +206,7 @@ fn area(caps: &[SphericalCap], c: Vec2, hs: f32, outside: Outside, depth: u32) -
     let mut which = 0usize;
     let w = hemisphere::unmap(c);
     for (k, cap) in caps.iter().enumerate() {
-        match classify(cap_fn_at(cap, w), LIP_CAP * h) {
+        match classify(cap_fn_at(cap, w), cap_bound(cap, w, h)) {
             St::In => {
                 any_in = true;
                 break;
@@ -340,7 +353,7 @@ fn block(
     let w = hemisphere::unmap(c);
     let (mut any_in, mut crossing) = (false, false);
     for cap in caps {
-        match classify(cap_fn_at(cap, w), LIP_CAP * h) {
+        match classify(cap_fn_at(cap, w), cap_bound(cap, w, h)) {
             St::In => {
                 any_in = true;
                 break;
