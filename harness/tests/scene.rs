@@ -631,10 +631,11 @@ fn lobes_simd_render_matches_the_scalar_one() {
 
 /// The `hvl` method's SIMD path (each receiver's HVLs summed by
 /// `steradian_simd::sh::hvl`: the diffuse part within `ZONAL_TOL` of the scalar kernel per
-/// HVL, the glossy parts bit for bit) against its scalar path on a small `room` and on
-/// `lobes` (Phong and Lafortune receivers): every pixel within `1e-7` of the image's largest
-/// value (measured: 6.5e-10; the indirect light is a small part of it); the test prints the
-/// measured worst difference.
+/// HVL, the glossy parts bit for bit; the direct light by `lobes::shade_x8`) against its
+/// scalar path on a small `room` and on `lobes` (Phong and Lafortune receivers): every pixel
+/// within `1e-6` of the image's largest value (measured: 2.9e-7, the direct light's share as
+/// in `lobes_simd_render_matches_the_scalar_one`); the test prints the measured worst
+/// difference.
 #[test]
 fn hvl_simd_render_matches_the_scalar_one() {
     use steradian_harness::scene::hvl;
@@ -657,7 +658,7 @@ fn hvl_simd_render_matches_the_scalar_one() {
             }
         }
         println!("{name}: {count} HVLs, worst |SIMD − scalar| = {worst:.2e} of the largest value");
-        assert!(worst <= 1e-7, "{name}: {worst:e}");
+        assert!(worst <= 1e-6, "{name}: {worst:e}");
         assert!(count > 0 && max > 0.0, "{name}");
     }
 }

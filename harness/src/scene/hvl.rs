@@ -52,7 +52,8 @@ pub struct Options {
     /// Sum each receiver's HVLs with the SIMD kernels (`steradian_simd::sh::hvl`: the
     /// diffuse part by `contributions_zonal`, eight HVLs at a time, within its `ZONAL_TOL`
     /// of the scalar kernel; the glossy parts by `contributions`, four at a time, bit for
-    /// bit); `false` the scalar kernels, one HVL at a time.
+    /// bit) and shade the direct light by the `lobes` method's SIMD path
+    /// ([`lobes::shade_x8`]); `false` the scalar kernels, one HVL and point at a time.
     pub simd: bool,
 }
 
@@ -723,10 +724,21 @@ pub fn render(scene: &Scene, o: &Options, bar: &ProgressBar) -> (Image, usize) {
     };
     let glossy = glossy.views();
     let new_state = || (ProductCounts::default(), Scratch::default());
-    let (img, _) = render_centres(scene, bar, new_state, |(counts, scratch), p| {
-        let d = lobes::shade(scene, p, &o.direct, counts);
-        let ind = indirect(scene, p, &hvls, o, &glossy, scratch);
-        [d[0] + ind[0], d[1] + ind[1], d[2] + ind[2]]
-    });
+    let (img, _) = if o.simd {
+        // The direct light by the `lobes` method's SIMD path, eight points at a time.
+        super::render_centres_x8(scene, bar, new_state, |(counts, scratch), ps, out| {
+            lobes::shade_x8(scene, ps, &o.direct, counts, out);
+            for (p, d) in ps.iter().zip(out.iter_mut()) {
+                let ind = indirect(scene, p, &hvls, o, &glossy, scratch);
+                *d = [d[0] + ind[0], d[1] + ind[1], d[2] + ind[2]];
+            }
+        })
+    } else {
+        render_centres(scene, bar, new_state, |(counts, scratch), p| {
+            let d = lobes::shade(scene, p, &o.direct, counts);
+            let ind = indirect(scene, p, &hvls, o, &glossy, scratch);
+            [d[0] + ind[0], d[1] + ind[1], d[2] + ind[2]]
+        })
+    };
     (img, hvls.len())
 }

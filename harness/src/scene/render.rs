@@ -364,8 +364,8 @@ pub fn plan(scene: &Scene, o: &Options) -> Result<Plan, String> {
                         "--scalar: every HVL by the scalar kernels, one at a time".into()
                     } else {
                         "each receiver's HVLs by the SIMD kernels: the diffuse part eight at a \
-                         time, the glossy parts four at a time (--scalar for the scalar ones, \
-                         --gpu for wgpu)"
+                         time, the glossy parts four at a time; the direct light by the lobes \
+                         SIMD path (--scalar for the scalar ones, --gpu for wgpu)"
                             .into()
                     },
                 });
