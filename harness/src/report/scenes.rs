@@ -8,9 +8,10 @@
 //! whose reference is the noisiest per sample), direct light for `lobes` and `cluster` and
 //! one bounce for `room`; the path tracer's curve is the same tracer with other seeds at
 //! [`PATH_SPP`] samples. The default point of `lobes` and `hvl` is what `steradian render`
-//! plans at the default target error (`planned`); `lobes` and `hvl` render with their SIMD
-//! paths (the default of `steradian render`), their scalar paths at the default setting
-//! variants. The
+//! plans at the default target error (`planned`); that of `rsl` is its plan with `K` set
+//! to the paper's 30 (its curve sweeps `K` at the plan's cube face, visibility side and
+//! coverage depth). Every method renders with its SIMD path (the default of `steradian
+//! render`), its scalar path at the default setting a variant. The
 //! `lobes` method's curve is its
 //! pruning threshold at the planned quadtree depth and every other depth at the planned
 //! threshold, with the L2 cap fit and
@@ -373,16 +374,23 @@ fn rsl_settings<'a>(
     scene: &'a Scene,
     gpu: Option<&'a std::sync::Mutex<crate::backend::gpu::Gpu>>,
 ) -> (Vec<Setting<'a>>, Vec<Setting<'a>>) {
-    let d = rsl::Options::default();
+    // What `steradian render` plans (cube face, visibility side, coverage depth) with K set
+    // to the paper's 30 and swept over `RSL_KS`; the plan's own K is in its JSON.
+    let paper_k = rsl::Options::default().k;
+    let d =
+        planned(scene, render::Method::Rsl).map_or_else(rsl::Options::default, |p| rsl::Options {
+            k: paper_k,
+            ..p.rsl
+        });
     let setting = |k: usize, kernel: RslKernel| {
         let o = rsl::Options { k, ..d };
         let (built, build_seconds) = timed(|| rsl::build(scene, &o));
         let (suffix, name) = match kernel {
-            RslKernel::Scalar => ("", "scalar"),
-            RslKernel::Simd => (", SIMD kernel", "simd"),
+            RslKernel::Scalar => (", scalar kernel", "scalar"),
+            RslKernel::Simd => ("", "simd"),
             RslKernel::Wgpu => (", wgpu", "wgpu"),
         };
-        let default = k == d.k && kernel == RslKernel::Scalar;
+        let default = k == d.k && kernel == RslKernel::Simd;
         Setting {
             label: format!("K = {k}{suffix}"),
             render: Box::new(move || {
@@ -407,14 +415,14 @@ fn rsl_settings<'a>(
             }),
             default,
             build_seconds: Some(build_seconds),
-            per_core: (default || kernel != RslKernel::Scalar).then_some(name),
+            per_core: (default || kernel != RslKernel::Simd).then_some(name),
         }
     };
     let curve = RSL_KS
         .iter()
-        .map(|&k| setting(k, RslKernel::Scalar))
+        .map(|&k| setting(k, RslKernel::Simd))
         .collect();
-    let mut variants = vec![setting(d.k, RslKernel::Simd)];
+    let mut variants = vec![setting(d.k, RslKernel::Scalar)];
     if gpu.is_some() {
         variants.push(setting(d.k, RslKernel::Wgpu));
     }
@@ -502,8 +510,7 @@ fn measure_scene(
         .iter()
         .map(|st| measure(st).map(|(p, _)| p))
         .collect::<Result<Vec<_>, _>>()?;
-    // Throughput on one core: the default setting (`lobes` and `hvl`: SIMD, `rsl` scalar),
-    // the kernel variants (`lobes` and `hvl` scalar, `rsl` SIMD) and `rsl`'s wgpu variant (one core
+    // Throughput on one core: the default setting (SIMD), the scalar variants and `rsl`'s wgpu variant (one core
     // building the visibility tables, the adapter shading), each the best of two renders in
     // a one-thread pool.
     let surface_points = (0..scene.camera.height)
