@@ -377,7 +377,8 @@ pub fn plan(scene: &Scene, o: &Options) -> Result<Plan, String> {
                     reason: if o.scalar {
                         "--scalar: every product by the scalar kernel, one point at a time".into()
                     } else {
-                        "each light's lobe times the cosine by the SIMD product kernel, eight                          points at a time, the rest lane by lane (--scalar for the scalar one)"
+                        "each light's lobe times the cosine by the SIMD product kernel, eight \
+                         points at a time, the rest lane by lane (--scalar for the scalar one)"
                             .into()
                     },
                 });
