@@ -178,6 +178,8 @@ pub struct Scratch {
     diffuse_c: Vec<f32>,
     glossy_c: Vec<Vec<f32>>,
     sh4: Vec<[f32; 4]>,
+    /// The SIMD kernels' contiguous HVLs (refilled per receiver, not reallocated).
+    lights: Vec<core_hvl::Hvl>,
 }
 
 impl Default for Scratch {
@@ -191,6 +193,7 @@ impl Default for Scratch {
             diffuse_c: Vec::new(),
             glossy_c: Vec::new(),
             sh4: Vec::new(),
+            lights: Vec::new(),
         }
     }
 }
@@ -369,6 +372,7 @@ fn indirect_parts(
         diffuse_c,
         glossy_c,
         sh4,
+        lights,
     } = scratch;
     let Some((frame, theta, n)) = lambert_zonal(p, o.bands, coeffs, zonal) else {
         return [0.0; 3];
@@ -398,12 +402,14 @@ fn indirect_parts(
     // The SIMD path: every HVL's share of each part first, batched.
     let batched = o.simd && !hvls.is_empty();
     if batched {
-        let lights: Vec<core_hvl::Hvl> = hvls.iter().map(|h| h.hvl).collect();
+        lights.clear();
+        lights.extend(hvls.iter().map(|h| h.hvl));
+        let lights = &lights[..];
         let horizon = core_hvl::Horizon::Smoothstep;
         diffuse_c.resize(hvls.len(), 0.0);
         if !diffuse
             || steradian_simd::sh::hvl::contributions_zonal(
-                &lights, &emission, &rx, horizon, sh, diffuse_c,
+                lights, &emission, &rx, horizon, sh, diffuse_c,
             )
             .is_err()
         {
@@ -420,7 +426,7 @@ fn indirect_parts(
             sh4.resize(f.len().max(1), [0.0; 4]);
             if !*on
                 || steradian_simd::sh::hvl::contributions(
-                    &lights, &emission, &grx, horizon, sh4, out,
+                    lights, &emission, &grx, horizon, sh4, out,
                 )
                 .is_err()
             {

@@ -24,6 +24,11 @@
 //!
 //! Pruning (section 4.3): each chain's threshold is `threshold × |its unshadowed value|`,
 //! so the bound of [`steradian_core::lobe::sum`] holds relative to the unshadowed radiance.
+//!
+//! [`shade`] is the scalar path; [`shade_x8`] (the default of `steradian render`, through
+//! [`render_simd`]) takes eight points at once through the SIMD product kernel for each
+//! light's lobe times the cosine and runs the rest of [`shade`] lane by lane. A light
+//! without occluders at a point skips the quadtree mask on both paths.
 
 use glam::{DVec3, Vec3};
 use indicatif::ProgressBar;
