@@ -8,7 +8,8 @@
 //! angle) preserves every band's norm on both paths (ZXZXZ and the built operator), which
 //! agree, for the SH of a direction and for arbitrary coefficients. The SIMD twins of
 //! the cap coefficients, of the irradiance and of the ZXZXZ rotation equal their scalar
-//! kernels bit for bit on the same arbitrary bits.
+//! kernels bit for bit on the same arbitrary bits; the zonal HVL twin is within its
+//! `zonal_bound` of the scalar kernel for HVLs at arbitrary positions and radii.
 
 use steradian_core::sh::rotate::{Operator, Rotation, Rotator, rotate_rel_error};
 use steradian_core::{Vec3, sh};
@@ -184,6 +185,77 @@ pub fn check(data: &[u8]) {
                 if let Ok(rot) = Rotation::from_axis_angle(axis, f32_at(rest, 100)) {
                     check_rotation(&rot, &one, bands);
                 }
+            }
+        }
+    }
+    check_zonal_hvls(&dirs, f32_at(rest, 48), &radiance, bands);
+}
+
+/// The zonal HVL twin (`steradian_simd::sh::hvl::contributions_zonal`) against the scalar
+/// `contribution_zonal` within its `zonal_bound`: HVLs at the four directions' bits taken as
+/// positions (with the HVL set twice: one whole pass of eight), facing the receiver at the
+/// origin, of radius `|a|` (clamped into `[1e-6, 1e6]`), and the receiver's `min(bands, 8)`
+/// zonal coefficients from the radiance bits (non-finite or beyond `1e6` ones replaced).
+fn check_zonal_hvls(dirs: &[Vec3], a: f32, radiance: &[f32], bands: usize) {
+    use sh::hvl::{Horizon, Hvl, ZonalReceiver, contribution_zonal, lambert_emission};
+    use steradian_simd::sh::hvl::{contributions_zonal, zonal_bound};
+    let radius = if a.is_nan() {
+        0.1
+    } else {
+        a.abs().clamp(1e-6, 1e6)
+    };
+    let hvls: Vec<Hvl> = dirs
+        .iter()
+        .chain(dirs)
+        .filter_map(|&p| Hvl::new(p, -p, Vec3::Z, radius, 1.0).ok())
+        .collect();
+    let coeffs: Vec<f32> = radiance
+        .iter()
+        .take(bands.min(8))
+        .map(|&v| {
+            if v.is_finite() && v.abs() <= 1e6 {
+                v
+            } else {
+                0.5
+            }
+        })
+        .collect();
+    let Ok(frame) = steradian_core::frame::Frame::from_normal(Vec3::Z) else {
+        return;
+    };
+    let rx = ZonalReceiver {
+        point: Vec3::ZERO,
+        frame,
+        coeffs: &coeffs,
+    };
+    let emission = lambert_emission(0.8);
+    let mut scratch = vec![0.0f32; coeffs.len().max(1)];
+    let mut out = vec![0.0f32; hvls.len()];
+    contributions_zonal(
+        &hvls,
+        &emission,
+        &rx,
+        Horizon::Smoothstep,
+        &mut scratch,
+        &mut out,
+    )
+    .expect("valid shapes");
+    for (h, got) in hvls.iter().zip(out) {
+        let want = contribution_zonal(h, &emission, &rx, Horizon::Smoothstep, &mut scratch)
+            .expect("valid shapes");
+        match zonal_bound(h, &emission, &rx, &mut scratch).expect("valid shapes") {
+            None => assert!(
+                same_bits(got, want),
+                "settled HVL at {}: {got} vs {want}",
+                h.position()
+            ),
+            Some(bound) => {
+                let err = (f64::from(got) - f64::from(want)).abs();
+                assert!(
+                    err <= bound || (got.is_nan() && want.is_nan()),
+                    "HVL at {} r {radius}: {got} vs {want}, bound {bound:e}",
+                    h.position()
+                );
             }
         }
     }
