@@ -322,29 +322,12 @@ pub fn render_centres<S: Send>(
     new_state: impl Fn() -> S + Sync,
     shade: impl Fn(&mut S, &ShadingPoint) -> Rgb + Sync,
 ) -> (Image, Vec<S>) {
-    let cam = scene.camera;
-    let (w, h) = (cam.width as usize, cam.height as usize);
-    let rows: Vec<(Vec<Rgb>, S)> = (0..h)
-        .into_par_iter()
-        .map(|j| {
-            let mut state = new_state();
-            let row = (0..w)
-                .map(|i| match scene.see(&cam.centre_ray(i as u32, j as u32)) {
-                    Seen::Radiance(l) => l,
-                    Seen::Surface(p) => shade(&mut state, &p),
-                })
-                .collect();
-            bar.inc(1);
-            (row, state)
-        })
-        .collect();
-    let mut img = Image::new(w, h);
-    let mut states = Vec::with_capacity(h);
-    for (j, (row, state)) in rows.into_iter().enumerate() {
-        img.data[j * w..(j + 1) * w].copy_from_slice(&row);
-        states.push(state);
-    }
-    (img, states)
+    // The same walk as the batched one, each point alone (in the same order per row).
+    render_centres_x8(scene, bar, new_state, |state, points, out| {
+        for (p, o) in points.iter().zip(out.iter_mut()) {
+            *o = shade(state, p);
+        }
+    })
 }
 
 /// [`render_centres`] with the surface points of a row shaded eight at a time by

@@ -71,6 +71,19 @@ pub fn contributions_x4(
     Ok(core::array::from_fn(|k| value[k].unwrap_or(r[k])))
 }
 
+/// One output per HVL.
+fn check_out(hvls: &[Hvl], out: &[f32]) -> Result<(), Error> {
+    if out.len() != hvls.len() {
+        return Err(Error::OutOfRange {
+            what: "HVL output length",
+            value: out.len() as f32,
+            min: hvls.len() as f32,
+            max: hvls.len() as f32,
+        });
+    }
+    Ok(())
+}
+
 /// [`contributions_x4`] over a slice of HVLs: `out[j]` is HVL `j`'s contribution to `rx`.
 /// Any length (the tail repeats the last HVL and is not written).
 ///
@@ -83,14 +96,7 @@ pub fn contributions(
     scratch: &mut [[f32; 4]],
     out: &mut [f32],
 ) -> Result<(), Error> {
-    if out.len() != hvls.len() {
-        return Err(Error::OutOfRange {
-            what: "HVL output length",
-            value: out.len() as f32,
-            min: hvls.len() as f32,
-            max: hvls.len() as f32,
-        });
-    }
+    check_out(hvls, out)?;
     for (group, out) in hvls.chunks(4).zip(out.chunks_mut(4)) {
         let four: [&Hvl; 4] = core::array::from_fn(|k| &group[k.min(group.len() - 1)]);
         let c = contributions_x4(four, emission, rx, horizon, scratch)?;
@@ -338,14 +344,7 @@ pub fn contributions_zonal(
     scratch: &mut [f32],
     out: &mut [f32],
 ) -> Result<(), Error> {
-    if out.len() != hvls.len() {
-        return Err(Error::OutOfRange {
-            what: "HVL output length",
-            value: out.len() as f32,
-            min: hvls.len() as f32,
-            max: hvls.len() as f32,
-        });
-    }
+    check_out(hvls, out)?;
     let Some(first) = hvls.first() else {
         return Ok(());
     };
