@@ -686,7 +686,7 @@ fn check_zonal(
             let want =
                 sh::hvl::contribution_zonal(h, emission, rx, horizon, &mut scratch).expect("valid");
             let got = out[j];
-            let bound = zonal_bound(h, emission, rx, &mut scratch).expect("valid shapes");
+            let bound = zonal_bound(h, emission, rx).expect("valid shapes");
             let (Some(bound), sh::hvl::Horizon::Smoothstep) = (bound, horizon) else {
                 assert!(same(got, want), "HVL {j} {horizon:?}: {got} vs {want}");
                 continue;

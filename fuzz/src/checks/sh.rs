@@ -243,7 +243,7 @@ fn check_zonal_hvls(dirs: &[Vec3], a: f32, radiance: &[f32], bands: usize) {
     for (h, got) in hvls.iter().zip(out) {
         let want = contribution_zonal(h, &emission, &rx, Horizon::Smoothstep, &mut scratch)
             .expect("valid shapes");
-        match zonal_bound(h, &emission, &rx, &mut scratch).expect("valid shapes") {
+        match zonal_bound(h, &emission, &rx).expect("valid shapes") {
             None => assert!(
                 same_bits(got, want),
                 "settled HVL at {}: {got} vs {want}",

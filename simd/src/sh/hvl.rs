@@ -107,60 +107,62 @@ pub fn contributions(
 
 /// The bound of [`contributions_zonal`] against the scalar
 /// `steradian_core::sh::hvl::contribution_zonal`: `|Δ| ≤ ZONAL_TOL·P·Ē·(G/H)·S̄`, the
-/// contribution without its horizon factor `H` and with each sum's terms in absolute value
-/// and each band scale at its largest: `Ē = Σ|F′_k·Y_k|`,
-/// `S̄ = Σ_l |F_l·Y_l⁰|·(1 + l²)·k̄`, `k̄ = 4π·max(sin²(a/2), sin²a) ≥ |k_l|` ([`zonal_bound`]).
-/// Relative to the terms, not to their sum: a receiver whose `F_l·C_l⁰` cancel, or a cap at
-/// the horizon, where the smoothstep's argument `t = (a + asin cos θ)/2a` cancels and an ulp
-/// of either arcsine moves `H` by up to `1.5·ulp(π/2)/2a`, has a larger error relative to
-/// its value. The `(1 + l²)·k̄` covers the scalar kernel's own rounding of `a` to `f32`:
-/// near `a = π/2` (a receiver within an HVL's radius) it moves `cos a` by up to `ulp(π/2)`
-/// and `k_l` (which vanishes for even `l ≥ 2` at `π/2` exactly) by up to about
-/// `l²·ulp(π/2)·k̄/16`, where this twin, from `sin a` itself, is exact. Measured by the lane
-/// tests of `simd/tests/sh.rs`; the `sh` fuzz target checks it on arbitrary positions.
+/// contribution without its horizon factor `H`, with every SH value and band scale at its
+/// largest magnitude: `Ē = Σ_k |F′_k|·y_l(k)`, `S̄ = Σ_l |F_l|·y_l·(1 + l²)·k̄`, where
+/// `y_l = √((2l + 1)/4π) ≥ |Y_l^m|` and `k̄ = 4π·max(sin²(a/2), sin²a) ≥ |k_l|`
+/// ([`zonal_bound`]). Relative to the terms' scale, not to the value: a basis value's
+/// rounding is absolute on its scale (it vanishes at the roots of `P_l`, the magic angle of
+/// `l = 2` included), a receiver's `F_l·C_l⁰` may cancel, and at a cap straddling the
+/// horizon the smoothstep's argument `t = (a + asin cos θ)/2a` cancels, where an ulp of
+/// either arcsine moves `H` by up to `1.5·ulp(π/2)/2a`. The `(1 + l²)` covers the scalar
+/// kernel's own rounding of `a` to `f32`: near `a = π/2` (a receiver within an HVL's
+/// radius) it moves `cos a` by up to `ulp(π/2)` and `k_l` (which vanishes for even `l ≥ 2`
+/// at `π/2` exactly) by up to about `l²·ulp(π/2)·k̄/16`, where this twin, from `sin a`
+/// itself, is exact. Measured by the lane tests of `simd/tests/sh.rs`; the `sh` fuzz target
+/// checks it on arbitrary positions, radii and coefficients.
 pub const ZONAL_TOL: f32 = 2e-6;
 
 /// The bound of [`contributions_zonal`] for one HVL: `ZONAL_TOL·P·Ē·(G/H)·S̄` ([`ZONAL_TOL`])
-/// from the scalar kernel's own terms (`steradian_core::sh::hvl::prepare`, the SH bases and
-/// `cap_trig`, summed in `f64`), `Some(bound)` where `prepare` lights the HVL with the
-/// smoothstep horizon, `None` where it settles it (both kernels then give the same bits).
-/// `scratch` at least `max(n, n_e²)` values. What the lane tests and the `sh` fuzz target
-/// check each lane against.
+/// from the scalar kernel's geometry (`steradian_core::sh::hvl::prepare`, `cap_trig`), in
+/// `f64`: `Some(bound)` where `prepare` lights the HVL with the smoothstep horizon, `None`
+/// where it settles it (both kernels then give the same bits). What the lane tests and the
+/// `sh` fuzz target check each lane against.
 ///
-/// Errors: those of the SH bases (an emission count that is not a square, a short
-/// `scratch`).
+/// Errors: an emission count that is not a square.
 pub fn zonal_bound(
     hvl: &Hvl,
     emission: &[f32],
     rx: &ZonalReceiver<'_>,
-    scratch: &mut [f32],
 ) -> Result<Option<f64>, Error> {
     use steradian_core::sh::hvl::horizon_smoothstep;
     let Prepared::Lit {
-        emit_dir,
         cap_axis,
         half_angle,
         power,
         g,
+        ..
     } = prepare(hvl, rx.point, &rx.frame, Horizon::Smoothstep)
     else {
         return Ok(None);
     };
+    // Each basis value at its largest, `|Y_l^m| ≤ √((2l + 1)/4π)` (its rounding is absolute
+    // on that scale, not relative to the value, which vanishes at the roots of `P_l`), and
+    // each band scale at its largest, `k̄ ≥ |k_l|`.
+    let y_max = |l: usize| ((2 * l + 1) as f64 / (4.0 * core::f64::consts::PI)).sqrt();
     let ne = steradian_core::sh::bands_of(emission.len())?;
-    steradian_core::sh::eval_into(emit_dir, ne, scratch)?;
-    let e_abs: f64 = emission
-        .iter()
-        .zip(scratch.iter())
-        .map(|(f, y)| f64::from(f * y).abs())
+    let e_abs: f64 = (0..ne)
+        .map(|l| {
+            let band = &emission[l * l..(l + 1) * (l + 1)];
+            band.iter().map(|f| f64::from(*f).abs()).sum::<f64>() * y_max(l)
+        })
         .sum();
     let n = rx.coeffs.len();
-    steradian_core::sh::eval_zonal_into(cap_axis, n, scratch)?;
     let [h2, s2, _] = steradian_core::sh::cap::cap_trig(half_angle);
     let k_max = 4.0 * core::f64::consts::PI * h2.max(s2);
     let s_abs: f64 = (0..n)
         .map(|l| {
             let l2 = (l * l) as f64;
-            (f64::from(rx.coeffs[l]) * f64::from(scratch[l])).abs() * (1.0 + l2) * k_max
+            f64::from(rx.coeffs[l]).abs() * y_max(l) * (1.0 + l2) * k_max
         })
         .sum();
     let h = f64::from(horizon_smoothstep(cap_axis.z, half_angle));
