@@ -118,8 +118,9 @@ pub fn contributions(
 /// kernel's own rounding of `a` to `f32`: near `a = π/2` (a receiver within an HVL's
 /// radius) it moves `cos a` by up to `ulp(π/2)` and `k_l` (which vanishes for even `l ≥ 2`
 /// at `π/2` exactly) by up to about `l²·ulp(π/2)·k̄/16`, where this twin, from `sin a`
-/// itself, is exact. Measured by the lane tests of `simd/tests/sh.rs`; the `sh` fuzz target
-/// checks it on arbitrary positions, radii and coefficients.
+/// itself, is exact. Plus `(2n + 2)·2⁻¹⁴⁹·(1 + P·Ē·G/H)` where `s` is subnormal (its
+/// roundings are then absolute). Measured by the lane tests of `simd/tests/sh.rs`; the `sh`
+/// fuzz target checks it on arbitrary positions, radii and coefficients.
 pub const ZONAL_TOL: f32 = 2e-6;
 
 /// The bound of [`contributions_zonal`] for one HVL: `ZONAL_TOL·P·Ē·(G/H)·S̄` ([`ZONAL_TOL`])
@@ -166,9 +167,11 @@ pub fn zonal_bound(
         })
         .sum();
     let h = f64::from(horizon_smoothstep(cap_axis.z, half_angle));
-    Ok(Some(
-        f64::from(ZONAL_TOL) * f64::from(power).abs() * e_abs * (f64::from(g) / h) * s_abs,
-    ))
+    let peg = f64::from(power).abs() * e_abs * (f64::from(g) / h);
+    // Where `s` is subnormal its roundings are absolute (at most `2⁻¹⁵⁰` each, two per band),
+    // and `P·e·G` scales them.
+    let underflow = (2 * n + 2) as f64 * f64::from(f32::from_bits(1)) * (1.0 + peg);
+    Ok(Some(f64::from(ZONAL_TOL) * peg * s_abs + underflow))
 }
 
 /// `asinf` on eight lanes by musl's (and the `libm` crate's) algorithm: `x + x·R(x²)` below
