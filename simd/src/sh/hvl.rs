@@ -149,7 +149,8 @@ pub fn zonal_bound(
     // Each basis value at its largest, `|Y_l^m| ≤ √((2l + 1)/4π)` (its rounding is absolute
     // on that scale, not relative to the value, which vanishes at the roots of `P_l`), and
     // each band scale at its largest, `k̄ ≥ |k_l|`.
-    let y_max = |l: usize| ((2 * l + 1) as f64 / (4.0 * core::f64::consts::PI)).sqrt();
+    let y_max =
+        |l: usize| steradian_core::math::sqrt64((2 * l + 1) as f64 / (4.0 * core::f64::consts::PI));
     let ne = steradian_core::sh::bands_of(emission.len())?;
     let e_abs: f64 = (0..ne)
         .map(|l| {
@@ -318,7 +319,7 @@ fn contributions_zonal_x8(
     for (l, f) in rx.coeffs.iter().enumerate().skip(1) {
         let lf = l as f64;
         let k = f64x8::splat(2.0 * pi) * s2 * dp / f64x8::splat(lf * (lf + 1.0));
-        let y = q * f64x8::splat(((2.0 * lf + 1.0) / (4.0 * pi)).sqrt());
+        let y = q * f64x8::splat(steradian_core::math::sqrt64((2.0 * lf + 1.0) / (4.0 * pi)));
         sum += splat(*f) * narrow(widen(narrow(y)) * k);
         let p_next = (f64x8::splat(2.0 * lf + 1.0) * ca * p - f64x8::splat(lf) * p_prev)
             / f64x8::splat(lf + 1.0);
@@ -334,10 +335,11 @@ fn contributions_zonal_x8(
     Ok(settled.select(value, lit).to_array())
 }
 
-/// [`contributions_zonal_x8`] over a slice of HVLs: `out[j]` is HVL `j`'s contribution to the
-/// zonal receiver `rx` (lane-wise `steradian_core::sh::hvl::contribution_zonal`, within
-/// [`ZONAL_TOL`] of it; with [`Horizon::Exact`] the scalar kernel
-/// itself, lane by lane). Any length. `scratch` at least `max(n, n_e²)` values.
+/// The contributions of a slice of HVLs to one zonal receiver, eight HVLs per pass with
+/// every step on lanes (module docs): `out[j]` is HVL `j`'s contribution to `rx`, lane-wise
+/// `steradian_core::sh::hvl::contribution_zonal` within [`ZONAL_TOL`] of it
+/// ([`zonal_bound`]); with [`Horizon::Exact`] the scalar kernel itself, lane by lane. Any
+/// length. `scratch` at least `max(n, n_e²)` values.
 ///
 /// Errors: those of the scalar kernel (an emission count that is not a square, more than
 /// `MAX_BANDS` bands, a short `scratch`); `out` of another length than `hvls`.
