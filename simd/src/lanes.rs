@@ -8,7 +8,19 @@
 
 use core::ops::{Add, BitAnd, BitOr, Div, Mul, Neg, Not, Sub};
 
-use wide::{f32x8, f32x16};
+use wide::{f32x8, f32x16, f64x8};
+
+/// Eight `f32` lanes as `f64` (exact).
+#[inline(always)]
+pub(crate) fn widen(x: f32x8) -> f64x8 {
+    f64x8::new(x.to_array().map(f64::from))
+}
+
+/// Eight `f64` lanes rounded to `f32` (as `as f32` rounds each).
+#[inline(always)]
+pub(crate) fn narrow(x: f64x8) -> f32x8 {
+    f32x8::new(x.to_array().map(|v| v as f32))
+}
 
 /// The vector the slice functions use: `f32x16` (one AVX-512 register) where the build
 /// enables AVX-512F, `f32x8` otherwise (one AVX register, or two 128-bit halves).

@@ -13,7 +13,7 @@
 use steradian_core::rsl::sat::{SatView, square_half_side};
 use wide::{f32x8, f64x8, i32x8, i64x8};
 
-use crate::lanes::{ColumnKernel, Lanes, drive};
+use crate::lanes::{ColumnKernel, Lanes, drive, widen};
 
 /// One axis of 8 boxes, lane-wise `steradian_core::rsl::sat::axis`: `(I0, a0, I1, a1)`, the
 /// indices as exact integers in `f32` lanes. A NaN lane gives NaN indices and fractions
@@ -42,11 +42,6 @@ fn axis(c0: f32x8, c1: f32x8, n: usize) -> (f32x8, f32x8, f32x8, f32x8) {
 #[inline(always)]
 fn indices(x: f32x8) -> [usize; 8] {
     x.trunc_int().to_array().map(|i| i as u32 as usize)
-}
-
-#[inline(always)]
-fn widen(x: f32x8) -> f64x8 {
-    f64x8::new(x.to_array().map(f64::from))
 }
 
 /// Eight box sums: lane `k` is `sat.box_sum(u0[k], v0[k], u1[k], v1[k])`, bit-identical.

@@ -35,6 +35,8 @@ use steradian_core::rsl::vdt::{R_MAX, R_MIN, VdtView};
 use steradian_core::rsl::vis_moments::{AxisKnots, VisMomentsView, axis_knots};
 use wide::{f32x8, f64x8, i64x8};
 
+use crate::lanes::widen;
+
 /// Relative difference allowed between [`shade_batch`] and the scalar kernel, per channel,
 /// relative to the point's largest channel (see the module docs).
 pub const REL_TOL: f32 = 2.0e-5;
@@ -123,11 +125,6 @@ fn sat_axis(lo: f32x8, hi: f32x8, n: usize) -> (f32x8, f32x8, f32x8, f32x8) {
 #[inline(always)]
 fn idx(x: f32x8) -> [usize; 8] {
     x.trunc_int().to_array().map(|i| i.max(0) as usize)
-}
-
-#[inline(always)]
-fn widen(x: f32x8) -> f64x8 {
-    f64x8::new(x.to_array().map(f64::from))
 }
 
 /// Two box sums per lane over the same boxes in tables `k0` and `k0 + 1` of each lane.

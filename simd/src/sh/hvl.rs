@@ -8,8 +8,8 @@
 //!
 //! [`contributions_zonal`] (eight HVLs to one zonal receiver per pass, the Lambertian
 //! receivers of the `hvl` render) runs every step on lanes instead, the geometry's two
-//! arcsines included, and is within [`ZONAL_TOL`] of `contribution_zonal`: 7–9 times the
-//! speed of the scalar kernel at 3–5 bands (`steradian report --section sh`, `hvl_ns[]`),
+//! arcsines included, and is within [`ZONAL_TOL`] of `contribution_zonal`: 7–10 times the
+//! speed of the scalar kernel at 3–9 bands (`steradian report --section sh`, `hvl_ns[]`),
 //! where the geometry done lane by lane leaves [`contributions`] 1.2–1.7 times faster.
 
 use steradian_core::sh::hvl::{
@@ -18,6 +18,8 @@ use steradian_core::sh::hvl::{
 use steradian_core::sh::{bands_of, check_shape};
 use steradian_core::{Error, Vec3};
 use wide::{f32x4, f32x8, f64x8};
+
+use crate::lanes::{narrow, widen};
 
 /// The contributions of four HVLs to the receiver `rx`, lane-wise
 /// `steradian_core::sh::hvl::contribution` with the same `emission` (the HVLs' material's
@@ -203,16 +205,6 @@ fn asin_x8(x: f32x8) -> f32x8 {
     ax.simd_gt(f32x8::ONE).select(f32x8::splat(f32::NAN), y)
 }
 
-#[inline(always)]
-fn widen(x: f32x8) -> f64x8 {
-    f64x8::new(x.to_array().map(f64::from))
-}
-
-#[inline(always)]
-fn narrow(x: f64x8) -> f32x8 {
-    f32x8::new(x.to_array().map(|v| v as f32))
-}
-
 /// The contributions of eight HVLs to one zonal receiver, lane-wise
 /// `steradian_core::sh::hvl::contribution_zonal` with the smoothstep horizon, every step on
 /// lanes: the geometry of `prepare` in `f32` (the same operations, with [`asin_x8`] for the
@@ -225,7 +217,6 @@ fn narrow(x: f64x8) -> f32x8 {
 /// [`ZONAL_TOL`] of the scalar kernel (tested); `Value` lanes
 /// (NaN distance, coincident, infinitely far, facing away, below the horizon) exactly.
 /// An emission of more than one band is evaluated lane by lane by the scalar SH kernel.
-#[allow(clippy::too_many_lines)]
 fn contributions_zonal_x8(
     hvls: [&Hvl; 8],
     emission: &[f32],
@@ -294,7 +285,6 @@ fn contributions_zonal_x8(
         f32x8::new(e)
     };
     // The cap's zonal coefficients `C_l⁰ = k_l·Y_l⁰(ω_j)`, dotted with `F_l`.
-    let n = rx.coeffs.len();
     let (tx, ty) = (rx.frame.tangent(), rx.frame.bitangent());
     let ax = wx * splat(tx.x) + wy * splat(tx.y) + wz * splat(tx.z);
     let ay = wx * splat(ty.x) + wy * splat(ty.y) + wz * splat(ty.z);
@@ -307,11 +297,14 @@ fn contributions_zonal_x8(
     let h2 = s2 / (f64x8::splat(2.0) * (one + ca));
     let pi = core::f64::consts::PI;
     let y00 = f64x8::splat(steradian_core::sh::Y00_F64);
-    let mut sum = splat(rx.coeffs.first().copied().unwrap_or(0.0))
-        * narrow(widen(narrow(y00 + f64x8::ZERO * z)) * (f64x8::splat(4.0 * pi) * h2));
-    if n == 0 {
-        sum = f32x8::ZERO;
-    }
+    // Band 0 (`band_scales`' `k_0 = 4π·sin²(a/2)`; `eval_zonal_into`'s `Y00 + 0·z`).
+    let mut sum = match rx.coeffs.first() {
+        Some(f0) => {
+            splat(*f0)
+                * narrow(widen(narrow(y00 + f64x8::ZERO * z)) * (f64x8::splat(4.0 * pi) * h2))
+        }
+        None => f32x8::ZERO,
+    };
     // Band scales (`band_scales`) and Legendre polynomials `P_l(z)` side by side.
     let (mut p_prev, mut p) = (one, ca);
     let (mut dp_prev, mut dp) = (f64x8::ZERO, one);
