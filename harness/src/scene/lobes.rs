@@ -151,11 +151,7 @@ pub fn shade_x8(
             // `lobe_product`: the unit product scaled by the light lobe's scale (the cosine's
             // is 1); `push_times_cosine`'s count.
             let q = products[k];
-            let lp = CosineLobe::saturating(
-                q.axis(),
-                q.scale() * (lobes[k].scale() * 1.0),
-                q.exponent(),
-            );
+            let lp = CosineLobe::saturating(q.axis(), q.scale() * lobes[k].scale(), q.exponent());
             counts.computed += 1;
             let l = LobeSum::<1>::from_lobes(0.0, &[lp]);
             shade_light(
