@@ -258,6 +258,17 @@ fn lobes_settings(scene: &Scene) -> (Vec<Setting<'_>>, Vec<Setting<'_>>) {
             false,
         ),
         mk(
+            format!(
+                "lobe product for the unshadowed diffuse term (the paper), t = {:.0e}, depth {depth}",
+                d.threshold
+            ),
+            lobes::Options {
+                exact_diffuse: false,
+                ..d
+            },
+            false,
+        ),
+        mk(
             format!("one lobe per occluder, t = {:.0e}", d.threshold),
             lobes::Options {
                 visibility: lobes::Visibility::PerOccluder,
