@@ -188,10 +188,12 @@ pub fn plan(scene: &Scene, o: &Options) -> Result<Plan, String> {
             // The coverage depth first: the choice of K shades probes with it.
             use steradian_core::rsl::visibility::DEPTH_BOUNDS;
             r.vis_depth = super::rsl::coverage_depth_for(o.target_error);
+            let max_depth = r.vis_depth;
             let choice = super::rsl::choose_k(scene, &r, o.target_error)?;
             let k_face = r.face;
             r.k = choice.k;
             r.vis_side = choice.vis_side;
+            r.vis_depth = choice.vis_depth;
             r.face = choice.face;
             let est = estimates_text("K = ", &choice.estimates);
             p.push(PlanItem {
@@ -271,9 +273,17 @@ pub fn plan(scene: &Scene, o: &Options) -> Result<Plan, String> {
                 item: "coverage_depth".into(),
                 value: json!(r.vis_depth),
                 reason: format!(
-                    "subdivision levels below a visibility texel: the coarsest whose visible \
-                     solid angle is within {:.1e} relative (a tenth of the target error {})",
-                    DEPTH_BOUNDS[r.vis_depth as usize].1, o.target_error
+                    "subdivision levels below a visibility texel: the coarsest of 0–{} (the \
+                     deepest whose asserted visible-solid-angle bound, {:.1e} relative, is \
+                     within a tenth of the target error {}) that keeps {} probe pixels within \
+                     {} of the target of depth {}'s, with the chosen K and side ({})",
+                    max_depth,
+                    DEPTH_BOUNDS[max_depth as usize].1,
+                    o.target_error,
+                    super::PROBES.0 * super::PROBES.1,
+                    super::PLAN_SHARE,
+                    max_depth,
+                    estimates_text("depth ", &choice.depth_estimates)
                 ),
             });
             if !scene.lights.is_empty() {

@@ -189,6 +189,10 @@ pub struct KChoice {
     pub vis_side: usize,
     /// `(side, estimate)` with the chosen `K`, as for `estimates`.
     pub side_estimates: Vec<(usize, f64)>,
+    /// The chosen coverage depth.
+    pub vis_depth: u32,
+    /// `(depth, estimate)` with the chosen `K` and side, as for `estimates`.
+    pub depth_estimates: Vec<(u32, f64)>,
     /// The chosen cube-map face side.
     pub face: usize,
     /// `(face, estimate)` with the chosen `K`, as for `estimates`.
@@ -209,7 +213,12 @@ pub struct KChoice {
 /// built at each side, at `o.vis_depth`): the cost of a point's map grows with its area
 /// while its error stops falling once the texels resolve the occluders' caps.
 ///
-/// Last, with the chosen `K` and side, the smallest cube-map face of [`FACE_CANDIDATES`]
+/// Then, with the chosen `K` and side, the coarsest coverage depth from 0 to `o.vis_depth`
+/// (the deepest the asserted bounds ask for, [`coverage_depth_for`]) by the same rule
+/// against `o.vis_depth`: each level below a texel costs about as much again, while the
+/// texels' coverage error is already small against the decomposition's.
+///
+/// Last, with the chosen `K`, side and depth, the smallest cube-map face of [`FACE_CANDIDATES`]
 /// (holding at least `K` texels) by the same rule against the largest face: the
 /// decomposition's cost grows with the face's area, while `K` squares cannot show detail
 /// finer than they are.
@@ -273,8 +282,34 @@ pub fn choose_k(scene: &Scene, o: &Options, target: f64) -> Result<KChoice, Stri
         .collect();
     let (vis_side, side_estimates) = super::plan_choice(&VIS_SIDE_CANDIDATES, &side_images, target)
         .ok_or("no visibility-map side")?;
-    // The cube-map face with the chosen K and side (the SATs shared, fitted above).
-    let os = Options { vis_side, ..*o };
+    // The coverage depth with the chosen K and side.
+    let depths: Vec<u32> = (0..=o.vis_depth).collect();
+    let depth_images: Vec<Vec<Rgb>> = depths
+        .iter()
+        .map(|&vis_depth| {
+            let os = Options {
+                vis_side,
+                vis_depth,
+                ..*o
+            };
+            let mut cov = vec![0.0f32; vis_side * vis_side];
+            points
+                .iter()
+                .map(|p| match point_moments(scene, &os, p, &mut cov) {
+                    Some((frame, m)) => shade_with(scene, &b, p, &frame, &m),
+                    None => [0.0; 3],
+                })
+                .collect()
+        })
+        .collect();
+    let (vis_depth, depth_estimates) =
+        super::plan_choice(&depths, &depth_images, target).ok_or("no coverage depth")?;
+    // The cube-map face with the chosen K, side and depth (the SATs shared, fitted above).
+    let os = Options {
+        vis_side,
+        vis_depth,
+        ..*o
+    };
     let mut cov = vec![0.0f32; vis_side * vis_side];
     let probes: Vec<_> = points
         .iter()
@@ -308,6 +343,8 @@ pub fn choose_k(scene: &Scene, o: &Options, target: f64) -> Result<KChoice, Stri
         estimates,
         vis_side,
         side_estimates,
+        vis_depth,
+        depth_estimates,
         face,
         face_estimates,
     })
