@@ -32,7 +32,7 @@ use steradian_core::lobe::sum::ProductCounts;
 use steradian_core::sh::{brdf, hvl as core_hvl};
 
 use super::image::Image;
-use super::{Kind, Ray, Rgb, Scene, ShadingPoint, lobes, path, render_centres};
+use super::{Kind, Ray, Rgb, Scene, ShadingPoint, Shape, lobes, path, render_centres};
 
 /// Settings of the `hvl` method.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -180,6 +180,57 @@ pub struct Scratch {
     sh4: Vec<[f32; 4]>,
     /// The SIMD kernels' contiguous HVLs (refilled per receiver, not reallocated).
     lights: Vec<core_hvl::Hvl>,
+    /// [`ShadowCull`] of the HVLs last shaded with.
+    cull: ShadowCull,
+}
+
+/// What the shadow rays toward one placement of HVLs can leave out: per scene object, how
+/// far behind a plane its farthest HVL lies (`δ = max(0, max_h −n·(h − p))`, a rounding
+/// of the `f32` positions for the HVLs on the plane itself; `∞` for spheres), and the
+/// objects a receiver tests (refilled per receiver). From an origin in front of a plane by
+/// `s > 2δ/ε`, a segment toward an HVL crosses the plane, if at all, beyond the fraction
+/// `s/(s + δ) > 1 − ε/2` of its length (`n·(x − p)` is linear along it), past the ray's
+/// `t_max`, which stops `ε = 1e-4` short of the HVL (far above the rounding of the hit
+/// distance): the plane holds no hit and is left out. In a closed convex room no wall is
+/// tested.
+#[derive(Default)]
+struct ShadowCull {
+    /// The placement the depths are of: its first HVL's address and its length.
+    of: (usize, usize),
+    behind: Vec<f64>,
+    tests: Vec<usize>,
+}
+
+impl ShadowCull {
+    /// The depths for `hvls` (computed once per placement).
+    fn prepare(&mut self, scene: &Scene, hvls: &[Placed]) {
+        let key = (hvls.as_ptr() as usize, hvls.len());
+        if self.of == key && self.behind.len() == scene.objects.len() {
+            return;
+        }
+        self.of = key;
+        self.behind.clear();
+        self.behind
+            .extend(scene.objects.iter().map(|obj| match obj.shape {
+                Shape::Plane { point, normal } => hvls.iter().fold(0.0, |m: f64, h| {
+                    m.max(-normal.dot(h.hvl.position().as_dvec3() - point))
+                }),
+                Shape::Sphere { .. } => f64::INFINITY,
+            }));
+    }
+
+    /// The objects a shadow ray from `origin` tests, in `self.tests`.
+    fn receiver(&mut self, scene: &Scene, origin: DVec3) {
+        self.tests.clear();
+        for (id, obj) in scene.objects.iter().enumerate() {
+            if let Shape::Plane { point, normal } = obj.shape
+                && self.behind[id] < 0.5 * f64::from(SHADOW_EPS) * normal.dot(origin - point)
+            {
+                continue;
+            }
+            self.tests.push(id);
+        }
+    }
 }
 
 impl Default for Scratch {
@@ -194,6 +245,7 @@ impl Default for Scratch {
             glossy_c: Vec::new(),
             sh4: Vec::new(),
             lights: Vec::new(),
+            cull: ShadowCull::default(),
         }
     }
 }
@@ -373,6 +425,7 @@ fn indirect_parts(
         glossy_c,
         sh4,
         lights,
+        cull,
     } = scratch;
     let Some((frame, theta, n)) = lambert_zonal(p, o.bands, coeffs, zonal) else {
         return [0.0; 3];
@@ -435,6 +488,10 @@ fn indirect_parts(
         }
     }
     let origin = path::offset(p.x, p.n);
+    if o.visibility {
+        cull.prepare(scene, hvls);
+        cull.receiver(scene, origin);
+    }
     let mut acc = [0.0f64; 3];
     let mut gacc = [[0.0f64; 3]; super::material::MAX_LOBES];
     let mut shares = [0.0f64; super::material::MAX_LOBES];
@@ -482,7 +539,13 @@ fn indirect_parts(
                 o: origin,
                 d: to / d,
             };
-            if scene.occluded(&ray, 0.0, d * (1.0 - f64::from(SHADOW_EPS))) {
+            let t_max = d * (1.0 - f64::from(SHADOW_EPS));
+            if cull.tests.iter().any(|&id| {
+                scene.objects[id]
+                    .shape
+                    .intersect(&ray, 0.0, t_max)
+                    .is_some()
+            }) {
                 continue;
             }
         }
@@ -747,4 +810,66 @@ pub fn render(scene: &Scene, o: &Options, bar: &ProgressBar) -> (Image, usize) {
         })
     };
     (img, hvls.len())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The culled shadow test against `Scene::occluded` on every object, for every HVL of a
+    /// placement from probe points: on the closed `room` (every wall culled), on `room`
+    /// with one wall turned outward (its HVLs behind it: never culled), and on `lobes`
+    /// (an open floor).
+    #[test]
+    fn culled_shadow_rays_match_every_object_tested() {
+        let mut flipped = Scene::load("builtin:room").unwrap();
+        let wall = flipped
+            .objects
+            .iter()
+            .position(|o| matches!(o.shape, Shape::Plane { .. }))
+            .unwrap();
+        if let Shape::Plane { normal, .. } = &mut flipped.objects[wall].shape {
+            *normal = -*normal;
+        }
+        let mut culled_walls = 0;
+        for scene in [
+            Scene::load("builtin:room").unwrap(),
+            flipped,
+            Scene::load("builtin:lobes").unwrap(),
+        ] {
+            let hvls = place(&scene, 4);
+            let mut cull = ShadowCull::default();
+            let (mut pairs, mut blocked) = (0, 0);
+            for p in super::super::probe_points(&scene) {
+                let origin = path::offset(p.x, p.n);
+                cull.prepare(&scene, &hvls);
+                cull.receiver(&scene, origin);
+                culled_walls += scene.objects.len() - cull.tests.len();
+                for h in &hvls {
+                    let to = h.hvl.position().as_dvec3() - origin;
+                    let d = to.length();
+                    let ray = Ray {
+                        o: origin,
+                        d: to / d,
+                    };
+                    let t_max = d * (1.0 - f64::from(SHADOW_EPS));
+                    let all = scene.occluded(&ray, 0.0, t_max);
+                    let some = cull.tests.iter().any(|&id| {
+                        scene.objects[id]
+                            .shape
+                            .intersect(&ray, 0.0, t_max)
+                            .is_some()
+                    });
+                    assert_eq!(all, some, "HVL on object {} from {origin}", h.object);
+                    pairs += 1;
+                    blocked += usize::from(all);
+                }
+            }
+            assert!(
+                pairs > 10_000 && blocked > 100,
+                "{pairs} pairs, {blocked} blocked"
+            );
+        }
+        assert!(culled_walls > 1000, "{culled_walls}");
+    }
 }
