@@ -105,12 +105,23 @@ pub fn shade(scene: &Scene, p: &ShadingPoint, o: &Options, counts: &mut ProductC
         let Some(cap) = light_cap(scene, p, li) else {
             continue;
         };
-        let mut l = LobeSum::<1>::new();
-        l.push_cap(&cap, 1.0, o.fit);
-        let l = light_with_cosine(&l, rx.normal, Cosine::WithLight, counts);
-        shade_light(scene, p, &rx, li, &cap, &l, o, counts, &mut out);
+        let occ = occluders(scene, p, li);
+        let l = needs_product(&rx, &occ, o).then(|| light_lobe(&cap, rx.normal, o, counts));
+        shade_light(scene, &rx, li, &cap, l.as_ref(), &occ, o, counts, &mut out);
     }
     out
+}
+
+/// The light's cap as one lobe (`o.fit`) times the cosine about `normal`.
+fn light_lobe(
+    cap: &SphericalCap,
+    normal: Vec3,
+    o: &Options,
+    counts: &mut ProductCounts,
+) -> LobeSum<1> {
+    let mut l = LobeSum::<1>::new();
+    l.push_cap(cap, 1.0, o.fit);
+    light_with_cosine(&l, normal, Cosine::WithLight, counts)
 }
 
 /// [`shade`] of up to eight points at once (`out[k]` for `points[k]`), the product of each
@@ -140,6 +151,31 @@ pub fn shade_x8(
     for li in 0..scene.lights.len() {
         let caps: Vec<Option<SphericalCap>> =
             points.iter().map(|p| light_cap(scene, p, li)).collect();
+        let occ: Vec<Vec<SphericalCap>> = points
+            .iter()
+            .zip(&caps)
+            .map(|(p, c)| c.map_or_else(Vec::new, |_| occluders(scene, p, li)))
+            .collect();
+        let needs: Vec<bool> = (0..points.len())
+            .map(|k| caps[k].is_some() && needs_product(&rxs[k], &occ[k], o))
+            .collect();
+        if !needs.contains(&true) {
+            for (k, cap) in caps.iter().enumerate() {
+                let Some(cap) = cap else { continue };
+                shade_light(
+                    scene,
+                    &rxs[k],
+                    li,
+                    cap,
+                    None,
+                    &occ[k],
+                    o,
+                    counts,
+                    &mut out[k],
+                );
+            }
+            continue;
+        }
         // `lobe_product`'s operands, as unit lobes (a pad where a lane has no light).
         let pad = CosineLobe::saturating(Vec3::Z, 0.0, 0.0);
         let lobes: Vec<CosineLobe> = caps
@@ -157,22 +193,13 @@ pub fn shade_x8(
         for (k, cap) in caps.iter().enumerate() {
             let Some(cap) = cap else { continue };
             // `lobe_product`: the unit product scaled by the light lobe's scale (the cosine's
-            // is 1); `push_times_cosine`'s count.
+            // is 1); `push_times_cosine`'s count, where a chain uses it.
             let q = products[k];
             let lp = CosineLobe::saturating(q.axis(), q.scale() * lobes[k].scale(), q.exponent());
-            counts.computed += 1;
             let l = LobeSum::<1>::from_lobes(0.0, &[lp]);
-            shade_light(
-                scene,
-                &points[k],
-                &rxs[k],
-                li,
-                cap,
-                &l,
-                o,
-                counts,
-                &mut out[k],
-            );
+            let l = needs[k].then_some(&l);
+            counts.computed += u64::from(needs[k]);
+            shade_light(scene, &rxs[k], li, cap, l, &occ[k], o, counts, &mut out[k]);
         }
     }
 }
@@ -213,25 +240,10 @@ fn light_cap(scene: &Scene, p: &ShadingPoint, li: usize) -> Option<SphericalCap>
     SphericalCap::from_sphere(Vec3::ZERO, f32v(light.center - x), light.radius as f32).ok()
 }
 
-/// Light `li`'s radiance at `p` added to `out`: its cap `cap`, its lobe times the cosine
-/// `l`, the visibility of its occluders (module docs) and the receiver's chains.
-#[allow(clippy::too_many_arguments)]
-fn shade_light(
-    scene: &Scene,
-    p: &ShadingPoint,
-    rx: &Receiver,
-    li: usize,
-    cap: &SphericalCap,
-    l: &LobeSum<1>,
-    o: &Options,
-    counts: &mut ProductCounts,
-    out: &mut Rgb,
-) {
+/// The caps of the spheres that can hide part of light `li` from `p` (module docs): nearer
+/// than the light's centre, their cap overlapping the light's.
+fn occluders(scene: &Scene, p: &ShadingPoint, li: usize) -> Vec<SphericalCap> {
     let (self_id, x, light) = (p.object, p.x, &scene.lights[li]);
-    let mut vis = LobeVec {
-        constant: 1.0,
-        lobes: Vec::new(),
-    };
     let rel = light.center - x;
     let d_light = rel.length();
     let (s_light, a_light) = ((light.radius / d_light).min(1.0), rel / d_light);
@@ -266,6 +278,36 @@ fn shade_light(
         };
         occluders.push(oc);
     }
+    occluders
+}
+
+/// Whether light `li` at a receiver needs its lobe times the cosine: a glossy chain, a
+/// shadow chain, or the paper's diffuse chain (the closed-form diffuse term of an
+/// unoccluded light does not).
+fn needs_product(rx: &Receiver, occluders: &[SphericalCap], o: &Options) -> bool {
+    !o.exact_diffuse || !occluders.is_empty() || rx.glossy.iter().next().is_some()
+}
+
+/// Light `li`'s radiance at a receiver `rx` added to `out`: its cap `cap`, its lobe times the cosine
+/// `l` (`None` where [`needs_product`] is false), the visibility of its `occluders` (module
+/// docs) and the receiver's chains.
+#[allow(clippy::too_many_arguments)]
+fn shade_light(
+    scene: &Scene,
+    rx: &Receiver,
+    li: usize,
+    cap: &SphericalCap,
+    l: Option<&LobeSum<1>>,
+    occluders: &[SphericalCap],
+    o: &Options,
+    counts: &mut ProductCounts,
+    out: &mut Rgb,
+) {
+    let light = &scene.lights[li];
+    let mut vis = LobeVec {
+        constant: 1.0,
+        lobes: Vec::new(),
+    };
     match o.visibility {
         Visibility::PerOccluder => {
             vis.lobes
@@ -282,8 +324,15 @@ fn shade_light(
         }
     }
     let unoccluded = LobeSum::<1>::unoccluded();
+    // The light's lobe times the cosine, formed here if a chain runs without it (not
+    // where `needs_product` is false: then no chain runs).
+    let mut own = None;
     // A chain's unshadowed and shadowed values.
     let mut chain = |r: &LobeSum<1>| -> (f64, f64) {
+        let l = match l {
+            Some(l) => l,
+            None => &*own.get_or_insert_with(|| light_lobe(cap, rx.normal, o, counts)),
+        };
         let u = triple(r, l, &unoccluded, 0.0, counts);
         if vis.lobes.is_empty() {
             return (u as f64, u as f64);
