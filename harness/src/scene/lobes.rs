@@ -317,7 +317,7 @@ fn shade_light(
         Visibility::Mask { .. } if occluders.is_empty() => {}
         Visibility::Mask { depth, leaves } => {
             let dist = mask::dist_of(cap.half_angle());
-            mask::shadow_leaves(cap, &occluders, depth, leaves, |leaf, d| {
+            mask::shadow_leaves(cap, occluders, depth, leaves, |leaf, d| {
                 let w = mask::weight(&mask::WEIGHTS, dist, d);
                 vis.lobes.push(leaf.lobe(-w, o.fit));
             });
