@@ -846,8 +846,8 @@ fn assert_choice<T: Copy + PartialEq + std::fmt::Debug>(
 }
 
 /// `rsl` plans K from the target error (`choose_k`): the estimates fall with K, the chosen
-/// K is the smallest within `PLAN_SHARE` of the target (the visibility-map side and the
-/// cube-map face by the same rule), a loose target takes a small K, and the
+/// K is the smallest within `PLAN_SHARE` of the target (the visibility-map side, the
+/// coverage depth and the cube-map face by the same rule), a loose target takes a small K, and the
 /// render at the chosen K meets the target against the path tracer (plus four times the
 /// reference's noise) at 48 columns, with under half the noise-corrected relative L2 of
 /// the paper's K = 30.
@@ -864,6 +864,17 @@ fn rsl_plans_k_from_the_target_error() {
     assert_eq!(c.side_estimates.last(), Some(&(64, 0.0)));
     assert_choice(&c.side_estimates, c.vis_side, target);
     assert_eq!(c.vis_side, 16);
+    // The coverage depth by the same rule, from 0 to the bound-based depth (the
+    // estimates need not fall with depth: each level's leaves err on either side).
+    assert_eq!(c.depth_estimates.last(), Some(&(o.vis_depth, 0.0)));
+    assert_eq!(c.depth_estimates.len(), o.vis_depth as usize + 1);
+    let first = c
+        .depth_estimates
+        .iter()
+        .find(|x| x.1 <= scene::PLAN_SHARE * target)
+        .map(|x| x.0);
+    assert_eq!(first, Some(c.vis_depth), "{:?}", c.depth_estimates);
+    assert_eq!(c.vis_depth, 0, "{:?}", c.depth_estimates);
     // The cube-map face by the same rule, every candidate holding K texels.
     assert_eq!(c.face_estimates.last(), Some(&(64, 0.0)));
     assert!(c.face_estimates.iter().all(|&(f, _)| 6 * f * f >= c.k));
@@ -877,6 +888,7 @@ fn rsl_plans_k_from_the_target_error() {
         &rsl::Options {
             k: c.k,
             vis_side: c.vis_side,
+            vis_depth: c.vis_depth,
             face: c.face,
             ..o
         },
