@@ -421,7 +421,7 @@ fn lobes_method_against_the_path_tracer_on_small_builtin_scenes() {
 /// The `lobes` method's closed-form unshadowed diffuse term (`Options::exact_diffuse`, the
 /// default) against the paper's lobe product of the cap's lobe with the cosine, on small
 /// renders against a 4096-spp reference whose noise is under half the difference: at
-/// most 0.7× the error on `lobes` and `cluster` (measured 0.61× and 0.59×).
+/// most 0.7× the error on `lobes` and `cluster` (measured 0.58× on both).
 #[test]
 fn exact_diffuse_term_against_a_converged_reference() {
     let hidden = ProgressBar::hidden();
@@ -950,8 +950,11 @@ fn lobes_plans_the_quadtree_depth_from_the_target_error() {
         eprintln!("{name}: {c:?}");
         assert_eq!(c.estimates.last(), Some(&(MAX_DEPTH, 0.0)));
         assert_choice(&c.estimates, c.depth, target);
-        // The README's figure: depth 2 on both scenes at 64 columns.
-        assert_eq!(c.depth, 2, "{name}: {c:?}");
+        // The README's figure at 64 columns: depth 1 on `lobes` (where the diffuse term
+        // of its floor's shadows is exact, only the glossy spheres use the mask) and 2 on
+        // `cluster`.
+        let expected = if name == "lobes" { 1 } else { 2 };
+        assert_eq!(c.depth, expected, "{name}: {c:?}");
         let lobes::Visibility::Mask { depth, .. } = planned.visibility else {
             panic!("the plan uses the mask")
         };
@@ -984,14 +987,13 @@ fn lobes_plans_the_quadtree_depth_from_the_target_error() {
             m.mean_abs_over_max,
             deep.mean_abs_over_max
         );
-        // On `lobes` the whole render is within the target. (On `cluster` at 64 columns
-        // the lobe model alone errs by 3.2e-3 at every depth, beyond the target.)
-        if name == "lobes" {
-            assert!(
-                m.mean_abs_over_max < target + 4.0 * m.reference_noise_over_max,
-                "{name}: {m:?}"
-            );
-        }
+        // The whole render is within the target on both scenes (`cluster` at 2.6e-3 of its
+        // 2.8e-3, most of it pixels whose small spheres and shadow edges the reference's
+        // box filter averages and a pixel-centre method does not).
+        assert!(
+            m.mean_abs_over_max < target + 4.0 * m.reference_noise_over_max,
+            "{name}: {m:?}"
+        );
     }
 }
 

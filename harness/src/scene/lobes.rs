@@ -12,7 +12,11 @@
 //!   is an exact scale of the same scalar integral;
 //! - visibility is `1 − Σ_k w_k·c_k` (eq. 39–41): by default over the shadow leaves of the
 //!   quadtree mask of section 5.3 with the fitted weights ([`Visibility::Mask`]), or one
-//!   lobe of weight 1 per occluder ([`Visibility::PerOccluder`]).
+//!   lobe of weight 1 per occluder ([`Visibility::PerOccluder`]);
+//! - the diffuse term, by default ([`Options::exact_diffuse`]), is the exact unshadowed
+//!   integral ([`SphericalCap::clipped_cosine`]) less the exact part the occluders hide
+//!   ([`SphericalCap::overlap_moment`]) where the light's cap is above the horizon and the
+//!   occluders' caps are pairwise disjoint, else times the visible fraction the chain gives.
 //!
 //! Occluders are the spheres of the scene (surfaces and other lights) whose centre is
 //! nearer than the light's and whose cap overlaps the light's cap (`angle(a_l, a_o) <
@@ -73,7 +77,10 @@ pub struct Options {
     /// The unshadowed diffuse term in closed form ([`SphericalCap::clipped_cosine`], the
     /// sphere's exact cosine-weighted solid angle above the horizon) times the visible
     /// fraction the lobes give, in place of the lobe product of the cap's lobe with the
-    /// cosine (the paper). The harness test
+    /// cosine (the paper); where the light's cap is wholly above the horizon and the
+    /// occluders' caps are pairwise disjoint, what they hide of it is exact too
+    /// ([`SphericalCap::overlap_moment`]) and the mask serves the glossy chains only. The
+    /// harness test
     /// `lobes_method_against_the_path_tracer_on_small_builtin_scenes` asserts it more
     /// accurate against the path tracer on `lobes` and `cluster`.
     pub exact_diffuse: bool,
@@ -106,8 +113,15 @@ pub fn shade(scene: &Scene, p: &ShadingPoint, o: &Options, counts: &mut ProductC
             continue;
         };
         let occ = occluders(scene, p, li);
-        let l = needs_product(&rx, &occ, o).then(|| light_lobe(&cap, rx.normal, o, counts));
-        shade_light(scene, &rx, li, &cap, l.as_ref(), &occ, o, counts, &mut out);
+        let hidden = diffuse_hidden(&cap, &occ, rx.normal, o);
+        let l = needs_product(&rx, &occ, hidden, o).then(|| light_lobe(&cap, rx.normal, o, counts));
+        let lit = Lit {
+            cap: &cap,
+            l: l.as_ref(),
+            occluders: &occ,
+            hidden,
+        };
+        shade_light(scene, &rx, li, &lit, o, counts, &mut out);
     }
     out
 }
@@ -156,23 +170,22 @@ pub fn shade_x8(
             .zip(&caps)
             .map(|(p, c)| c.map_or_else(Vec::new, |_| occluders(scene, p, li)))
             .collect();
+        let hidden: Vec<Option<f64>> = (0..points.len())
+            .map(|k| caps[k].and_then(|c| diffuse_hidden(&c, &occ[k], rxs[k].normal, o)))
+            .collect();
         let needs: Vec<bool> = (0..points.len())
-            .map(|k| caps[k].is_some() && needs_product(&rxs[k], &occ[k], o))
+            .map(|k| caps[k].is_some() && needs_product(&rxs[k], &occ[k], hidden[k], o))
             .collect();
         if !needs.contains(&true) {
             for (k, cap) in caps.iter().enumerate() {
                 let Some(cap) = cap else { continue };
-                shade_light(
-                    scene,
-                    &rxs[k],
-                    li,
+                let lit = Lit {
                     cap,
-                    None,
-                    &occ[k],
-                    o,
-                    counts,
-                    &mut out[k],
-                );
+                    l: None,
+                    occluders: &occ[k],
+                    hidden: hidden[k],
+                };
+                shade_light(scene, &rxs[k], li, &lit, o, counts, &mut out[k]);
             }
             continue;
         }
@@ -199,7 +212,13 @@ pub fn shade_x8(
             let l = LobeSum::<1>::from_lobes(0.0, &[lp]);
             let l = needs[k].then_some(&l);
             counts.computed += u64::from(needs[k]);
-            shade_light(scene, &rxs[k], li, cap, l, &occ[k], o, counts, &mut out[k]);
+            let lit = Lit {
+                cap,
+                l,
+                occluders: &occ[k],
+                hidden: hidden[k],
+            };
+            shade_light(scene, &rxs[k], li, &lit, o, counts, &mut out[k]);
         }
     }
 }
@@ -281,28 +300,85 @@ fn occluders(scene: &Scene, p: &ShadingPoint, li: usize) -> Vec<SphericalCap> {
     occluders
 }
 
-/// Whether light `li` at a receiver needs its lobe times the cosine: a glossy chain, a
-/// shadow chain, or the paper's diffuse chain (the closed-form diffuse term of an
-/// unoccluded light does not).
-fn needs_product(rx: &Receiver, occluders: &[SphericalCap], o: &Options) -> bool {
-    !o.exact_diffuse || !occluders.is_empty() || rx.glossy.iter().next().is_some()
+/// The cosine-weighted solid angle the occluders hide of the light's cap at a receiver
+/// with normal `n`, exactly: `Σᵢ n·overlap_moment(cap, occluderᵢ)`
+/// ([`SphericalCap::overlap_moment`]), which is exact where the light's cap lies wholly
+/// above the horizon (so every hidden direction has `n·ω > 0`) and the occluders' caps are
+/// pairwise disjoint (so no direction is hidden twice). `None` elsewhere (the lobe chain's
+/// visible fraction is used), or without [`Options::exact_diffuse`].
+fn diffuse_hidden(
+    cap: &SphericalCap,
+    occluders: &[SphericalCap],
+    n: Vec3,
+    o: &Options,
+) -> Option<f64> {
+    if !o.exact_diffuse {
+        return None;
+    }
+    let (cos_t, s) = (
+        f64::from(n.dot(cap.axis())),
+        f64::from(cap.half_angle()).sin(),
+    );
+    if cos_t < s {
+        return None;
+    }
+    for (i, a) in occluders.iter().enumerate() {
+        for b in &occluders[i + 1..] {
+            let d = f64::from(a.axis().dot(b.axis())).clamp(-1.0, 1.0).acos();
+            if d < f64::from(a.half_angle()) + f64::from(b.half_angle()) {
+                return None;
+            }
+        }
+    }
+    let n = n.as_dvec3();
+    Some(
+        occluders
+            .iter()
+            .map(|oc| n.dot(cap.overlap_moment(oc).as_dvec3()))
+            .sum(),
+    )
 }
 
-/// Light `li`'s radiance at a receiver `rx` added to `out`: its cap `cap`, its lobe times the cosine
-/// `l` (`None` where [`needs_product`] is false), the visibility of its `occluders` (module
-/// docs) and the receiver's chains.
-#[allow(clippy::too_many_arguments)]
+/// Whether a light at a receiver needs its lobe times the cosine: a glossy chain, a
+/// shadow chain the diffuse term cannot do without ([`diffuse_hidden`] is `None` with
+/// occluders), or the paper's diffuse chain.
+fn needs_product(
+    rx: &Receiver,
+    occluders: &[SphericalCap],
+    hidden: Option<f64>,
+    o: &Options,
+) -> bool {
+    !o.exact_diffuse
+        || (!occluders.is_empty() && hidden.is_none())
+        || rx.glossy.iter().next().is_some()
+}
+
+/// One light at one receiver: its cap, its lobe times the cosine (`None` where
+/// [`needs_product`] is false), the caps of its occluders and what they hide of the
+/// diffuse term when that is exact ([`diffuse_hidden`]).
+struct Lit<'a> {
+    cap: &'a SphericalCap,
+    l: Option<&'a LobeSum<1>>,
+    occluders: &'a [SphericalCap],
+    hidden: Option<f64>,
+}
+
+/// Light `li`'s radiance at a receiver `rx` added to `out` (module docs).
 fn shade_light(
     scene: &Scene,
     rx: &Receiver,
     li: usize,
-    cap: &SphericalCap,
-    l: Option<&LobeSum<1>>,
-    occluders: &[SphericalCap],
+    lit: &Lit<'_>,
     o: &Options,
     counts: &mut ProductCounts,
     out: &mut Rgb,
 ) {
+    let Lit {
+        cap,
+        l,
+        occluders,
+        hidden,
+    } = *lit;
     let light = &scene.lights[li];
     let mut vis = LobeVec {
         constant: 1.0,
@@ -313,8 +389,10 @@ fn shade_light(
             vis.lobes
                 .extend(occluders.iter().map(|oc| oc.lobe(-1.0, o.fit)));
         }
-        // No occluder, no shadow leaf: the mask is not walked.
-        Visibility::Mask { .. } if occluders.is_empty() => {}
+        // No occluder, no shadow leaf: the mask is not walked; nor where only the diffuse
+        // term would use it and that is exact.
+        Visibility::Mask { .. }
+            if occluders.is_empty() || (hidden.is_some() && rx.glossy.iter().next().is_none()) => {}
         Visibility::Mask { depth, leaves } => {
             let dist = mask::dist_of(cap.half_angle());
             mask::shadow_leaves(cap, occluders, depth, leaves, |leaf, d| {
@@ -341,7 +419,11 @@ fn shade_light(
         (u as f64, v as f64)
     };
     let diffuse = LobeSum::with_constant(1.0 / std::f32::consts::PI);
-    let i_d = if o.exact_diffuse {
+    let exact = || f64::from(cap.clipped_cosine(rx.normal));
+    let i_d = if let Some(hidden) = hidden {
+        // Exact: the unshadowed value less what the occluders hide of it.
+        (exact() - hidden).max(0.0) / std::f64::consts::PI
+    } else if o.exact_diffuse {
         // The exact unshadowed value times the lobes' visible fraction (all of it without
         // shadow lobes, or where the lobes leave nothing to divide).
         let visible = if vis.lobes.is_empty() {
@@ -354,7 +436,7 @@ fn shade_light(
                 1.0
             }
         };
-        f64::from(cap.clipped_cosine(rx.normal)) / std::f64::consts::PI * visible
+        exact() / std::f64::consts::PI * visible
     } else {
         chain(&diffuse).1
     };

@@ -338,9 +338,11 @@ pub fn plan(scene: &Scene, o: &Options) -> Result<Plan, String> {
                 item: "diffuse_term".into(),
                 value: json!("closed form × visible fraction"),
                 reason: "each light's unshadowed diffuse term is the sphere's exact \
-                         cosine-weighted solid angle above the horizon (Snyder 1996), times \
-                         the visible fraction of the lobe chain; the cap lobe × cosine product \
-                         of the paper has at least 1.4× (measured 1.6–1.7×) its error on `lobes` and \
+                         cosine-weighted solid angle above the horizon (Snyder 1996), less \
+                         the exact cap overlaps of pairwise disjoint occluders of a light \
+                         above the horizon, else times the visible fraction of the lobe \
+                         chain; the cap lobe × cosine product \
+                         of the paper has at least 1.4× (measured 1.7×) its error on `lobes` and \
                          `cluster` (the scene tests assert it)"
                     .into(),
             });
