@@ -283,13 +283,16 @@ fn occluders(scene: &Scene, p: &ShadingPoint, li: usize) -> Vec<SphericalCap> {
         // The caps overlap iff the angle θ between their axes is below α_l + α_o:
         // cos θ > cos α_l·cos α_o − sin α_l·sin α_o (both angles in [0, π/2],
         // sin α_o = r/d), times d: rc·a_l > cos α_l·√(d² − r²) − sin α_l·r. One square
-        // root and no inverse trigonometry for a sphere that is culled.
-        let (tangent, r_in) = if d2 > radius * radius {
-            ((d2 - radius * radius).sqrt(), radius)
+        // root and no inverse trigonometry for a sphere that is culled; outside the sphere
+        // `A = rc·a_l + sin α_l·r ≤ cos α_l·√(d² − r²)` is tested squared where `A > 0`,
+        // with no root at all.
+        let culled = if d2 > radius * radius {
+            let a = rc.dot(a_light) + s_light * radius;
+            a <= 0.0 || a * a <= c_light * c_light * (d2 - radius * radius)
         } else {
-            (0.0, d2.sqrt())
+            rc.dot(a_light) <= -s_light * d2.sqrt()
         };
-        if rc.dot(a_light) <= c_light * tangent - s_light * r_in {
+        if culled {
             continue;
         }
         let Ok(oc) = SphericalCap::from_sphere(Vec3::ZERO, f32v(rc), radius as f32) else {
