@@ -325,10 +325,17 @@ fn diffuse_hidden(
     if cos_t < s {
         return None;
     }
+    // Disjoint: the angle between the axes is at least `α_a + α_b`, i.e. (both below π/2)
+    // `cos d ≤ cos α_a·cos α_b − sin α_a·sin α_b`.
+    let sc = |c: &SphericalCap| {
+        let k = f64::from(c.one_minus_cos());
+        ((k * (2.0 - k)).sqrt(), 1.0 - k)
+    };
     for (i, a) in occluders.iter().enumerate() {
+        let (sa, ca) = sc(a);
         for b in &occluders[i + 1..] {
-            let d = f64::from(a.axis().dot(b.axis())).clamp(-1.0, 1.0).acos();
-            if d < f64::from(a.half_angle()) + f64::from(b.half_angle()) {
+            let (sb, cb) = sc(b);
+            if f64::from(a.axis().dot(b.axis())) > ca * cb - sa * sb {
                 return None;
             }
         }
