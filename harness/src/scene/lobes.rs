@@ -163,19 +163,21 @@ pub fn shade_x8(
     out.fill([0.0; 3]);
     let table = ProductTable::builtin();
     for li in 0..scene.lights.len() {
-        let caps: Vec<Option<SphericalCap>> =
-            points.iter().map(|p| light_cap(scene, p, li)).collect();
-        let occ: Vec<Vec<SphericalCap>> = points
-            .iter()
-            .zip(&caps)
-            .map(|(p, c)| c.map_or_else(Vec::new, |_| occluders(scene, p, li)))
-            .collect();
-        let hidden: Vec<Option<f64>> = (0..points.len())
-            .map(|k| caps[k].and_then(|c| diffuse_hidden(&c, &occ[k], rxs[k].normal, o)))
-            .collect();
-        let needs: Vec<bool> = (0..points.len())
-            .map(|k| caps[k].is_some() && needs_product(&rxs[k], &occ[k], hidden[k], o))
-            .collect();
+        // Per lane (fixed arrays: no allocation but the occluder lists that are not empty).
+        let n = points.len();
+        let caps: [Option<SphericalCap>; 8] =
+            core::array::from_fn(|k| points.get(k).and_then(|p| light_cap(scene, p, li)));
+        let occ: [Vec<SphericalCap>; 8] = core::array::from_fn(|k| match caps[k] {
+            Some(_) => occluders(scene, &points[k], li),
+            None => Vec::new(),
+        });
+        let hidden: [Option<f64>; 8] = core::array::from_fn(|k| {
+            caps[k].and_then(|c| diffuse_hidden(&c, &occ[k], rxs[k].normal, o))
+        });
+        let needs: [bool; 8] = core::array::from_fn(|k| {
+            caps[k].is_some() && needs_product(&rxs[k], &occ[k], hidden[k], o)
+        });
+        let caps = &caps[..n];
         if !needs.contains(&true) {
             for (k, cap) in caps.iter().enumerate() {
                 let Some(cap) = cap else { continue };
@@ -191,17 +193,20 @@ pub fn shade_x8(
         }
         // `lobe_product`'s operands, as unit lobes (a pad where a lane has no light).
         let pad = CosineLobe::saturating(Vec3::Z, 0.0, 0.0);
-        let lobes: Vec<CosineLobe> = caps
-            .iter()
-            .map(|c| c.map_or(pad, |c| c.lobe(1.0, o.fit)))
-            .collect();
+        let lobes: [CosineLobe; 8] = core::array::from_fn(|k| {
+            caps.get(k)
+                .copied()
+                .flatten()
+                .map_or(pad, |c| c.lobe(1.0, o.fit))
+        });
         let unit = |l: &CosineLobe| CosineLobe::saturating(l.axis(), 1.0, l.exponent());
-        let a = LobeX8::from_slice(&lobes.iter().map(unit).collect::<Vec<_>>());
-        let cosines: Vec<CosineLobe> = rxs
-            .iter()
-            .map(|rx| CosineLobe::saturating(rx.normal, 1.0, 1.0))
-            .collect();
-        let b = LobeX8::from_slice(&cosines);
+        let units: [CosineLobe; 8] = core::array::from_fn(|k| unit(&lobes[k]));
+        let a = LobeX8::from_slice(&units[..n]);
+        let cosines: [CosineLobe; 8] = core::array::from_fn(|k| {
+            rxs.get(k)
+                .map_or(pad, |rx| CosineLobe::saturating(rx.normal, 1.0, 1.0))
+        });
+        let b = LobeX8::from_slice(&cosines[..n]);
         let products = product_x8(&table, ProductFit::ExactIntegral, &a, &b).to_array();
         for (k, cap) in caps.iter().enumerate() {
             let Some(cap) = cap else { continue };
