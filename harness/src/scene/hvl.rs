@@ -193,12 +193,20 @@ pub struct Scratch {
 /// `t_max`, which stops `ε = 1e-4` short of the HVL (far above the rounding of the hit
 /// distance): the plane holds no hit and is left out. In a closed convex room no wall is
 /// tested.
+///
+/// A sphere is tested first by the cone of directions it subtends from the receiver: a
+/// unit direction `d` can meet it ahead only if `(c − o)·d ≥ √(|c − o|² − r²)` (the ray's
+/// closest approach within `r`, on the near side); the exact test runs only there
+/// (receivers inside a sphere always run it). The cone is widened by `1e-9` of the
+/// sphere's distance, far above the rounding of either side.
 #[derive(Default)]
 struct ShadowCull {
     /// The placement the depths are of: its first HVL's address and its length.
     of: (usize, usize),
     behind: Vec<f64>,
-    tests: Vec<usize>,
+    /// Per tested object: its index, and for a sphere `c − o` and the cone's threshold
+    /// (`−∞` where the receiver is inside or the object is a plane).
+    tests: Vec<(usize, DVec3, f64)>,
 }
 
 impl ShadowCull {
@@ -223,13 +231,32 @@ impl ShadowCull {
     fn receiver(&mut self, scene: &Scene, origin: DVec3) {
         self.tests.clear();
         for (id, obj) in scene.objects.iter().enumerate() {
-            if let Shape::Plane { point, normal } = obj.shape
-                && self.behind[id] < 0.5 * f64::from(SHADOW_EPS) * normal.dot(origin - point)
-            {
-                continue;
+            match obj.shape {
+                Shape::Plane { point, normal } => {
+                    if self.behind[id] >= 0.5 * f64::from(SHADOW_EPS) * normal.dot(origin - point) {
+                        self.tests.push((id, DVec3::ZERO, f64::NEG_INFINITY));
+                    }
+                }
+                Shape::Sphere { center, radius } => {
+                    let cmo = center - origin;
+                    let d2 = cmo.length_squared();
+                    let cone = if d2 > radius * radius {
+                        (d2 - radius * radius).sqrt() - 1e-9 * (d2.sqrt() + radius)
+                    } else {
+                        f64::NEG_INFINITY
+                    };
+                    self.tests.push((id, cmo, cone));
+                }
             }
-            self.tests.push(id);
         }
+    }
+
+    /// Whether the ray from the receiver's origin along `ray.d` (unit) meets a tested
+    /// object in `(0, t_max)`.
+    fn blocked(&self, scene: &Scene, ray: &Ray, t_max: f64) -> bool {
+        self.tests.iter().any(|&(id, cmo, cone)| {
+            cmo.dot(ray.d) >= cone && scene.objects[id].shape.intersect(ray, 0.0, t_max).is_some()
+        })
     }
 }
 
@@ -540,12 +567,7 @@ fn indirect_parts(
                 d: to / d,
             };
             let t_max = d * (1.0 - f64::from(SHADOW_EPS));
-            if cull.tests.iter().any(|&id| {
-                scene.objects[id]
-                    .shape
-                    .intersect(&ray, 0.0, t_max)
-                    .is_some()
-            }) {
+            if cull.blocked(scene, &ray, t_max) {
                 continue;
             }
         }
@@ -854,12 +876,7 @@ mod tests {
                     };
                     let t_max = d * (1.0 - f64::from(SHADOW_EPS));
                     let all = scene.occluded(&ray, 0.0, t_max);
-                    let some = cull.tests.iter().any(|&id| {
-                        scene.objects[id]
-                            .shape
-                            .intersect(&ray, 0.0, t_max)
-                            .is_some()
-                    });
+                    let some = cull.blocked(&scene, &ray, t_max);
                     assert_eq!(all, some, "HVL on object {} from {origin}", h.object);
                     pairs += 1;
                     blocked += usize::from(all);
