@@ -661,4 +661,67 @@ mod tests {
             "{m:?}"
         );
     }
+
+    /// Random caps (1e-4 rad to a whole sphere) and directions: the clipped cosine is
+    /// finite, within `[0, π·min(1, sin²α)]` for caps up to a hemisphere and `[0, π]`
+    /// beyond; an overlap's moment is finite, no longer than the smaller cap's
+    /// (`π sin²r` for caps up to a hemisphere), symmetric, and its cosine-weighted part
+    /// above a normal that sees the whole first cap is at most that cap's clipped cosine.
+    #[test]
+    fn clipped_cosine_and_overlap_moment_on_random_caps() {
+        let mut state = 0x9e37_79b9_7f4a_7c15u64;
+        let mut next = || {
+            state = state
+                .wrapping_mul(6_364_136_223_846_793_005)
+                .wrapping_add(1_442_695_040_888_963_407);
+            (state >> 40) as f32 / (1u64 << 24) as f32
+        };
+        let mut dir = |next: &mut dyn FnMut() -> f32| {
+            let z = 2.0 * next() - 1.0;
+            let phi = crate::TWO_PI * next();
+            let r = (1.0 - z * z).max(0.0).sqrt();
+            Vec3::new(r * phi.cos(), r * phi.sin(), z)
+        };
+        for _ in 0..20_000 {
+            let alpha = |u: f32| 1e-4f32 * (crate::PI / 1e-4).powf(u);
+            let a = SphericalCap::new(dir(&mut next), alpha(next())).unwrap();
+            let b = SphericalCap::new(dir(&mut next), alpha(next())).unwrap();
+            let n = dir(&mut next);
+            let sa2 = a.half_angle().sin().powi(2);
+            let top = if a.half_angle() <= FRAC_PI_2 {
+                crate::PI * sa2
+            } else {
+                crate::PI
+            };
+            let c = a.clipped_cosine(n);
+            assert!(
+                c.is_finite() && c >= 0.0 && c <= top * (1.0 + 1e-5),
+                "{a:?} {n} {c}"
+            );
+            let m = a.overlap_moment(&b);
+            let moment = |c: &SphericalCap| {
+                if c.half_angle() <= FRAC_PI_2 {
+                    crate::PI * c.half_angle().sin().powi(2)
+                } else {
+                    crate::PI
+                }
+            };
+            let cap = moment(&a).min(moment(&b));
+            assert!(
+                m.is_finite() && m.length() <= cap * (1.0 + 1e-4) + 1e-12,
+                "{a:?} {b:?} {m}"
+            );
+            let back = b.overlap_moment(&a);
+            assert!(
+                (back - m).length() <= 1e-5 * cap + 1e-12,
+                "{a:?} {b:?} {m} {back}"
+            );
+            if a.half_angle() <= FRAC_PI_2 && n.dot(a.axis()) >= a.half_angle().sin() {
+                assert!(
+                    n.dot(m) <= c * (1.0 + 1e-4) + 1e-12,
+                    "{a:?} {b:?} {n}: {m} vs {c}"
+                );
+            }
+        }
+    }
 }
