@@ -676,7 +676,7 @@ mod tests {
                 .wrapping_add(1_442_695_040_888_963_407);
             (state >> 40) as f32 / (1u64 << 24) as f32
         };
-        let mut dir = |next: &mut dyn FnMut() -> f32| {
+        let dir = |next: &mut dyn FnMut() -> f32| {
             let z = 2.0 * next() - 1.0;
             let phi = crate::TWO_PI * next();
             let r = (1.0 - z * z).max(0.0).sqrt();
