@@ -184,6 +184,20 @@ pub struct Scratch {
     cull: ShadowCull,
 }
 
+/// The shadow ray from a receiver's `origin` toward an HVL, unit direction, and its end
+/// `ε = SHADOW_EPS` short of the HVL (which lies on a surface).
+fn shadow_ray(origin: DVec3, h: &Placed) -> (Ray, f64) {
+    let to = h.hvl.position().as_dvec3() - origin;
+    let d = to.length();
+    (
+        Ray {
+            o: origin,
+            d: to / d,
+        },
+        d * (1.0 - f64::from(SHADOW_EPS)),
+    )
+}
+
 /// What the shadow rays toward one placement of HVLs can leave out: per scene object, how
 /// far behind a plane its farthest HVL lies (`δ = max(0, max_h −n·(h − p))`, a rounding
 /// of the `f32` positions for the HVLs on the plane itself; `∞` for spheres), and the
@@ -560,13 +574,7 @@ fn indirect_parts(
             continue;
         }
         if o.visibility {
-            let to = h.hvl.position().as_dvec3() - origin;
-            let d = to.length();
-            let ray = Ray {
-                o: origin,
-                d: to / d,
-            };
-            let t_max = d * (1.0 - f64::from(SHADOW_EPS));
+            let (ray, t_max) = shadow_ray(origin, h);
             if cull.blocked(scene, &ray, t_max) {
                 continue;
             }
@@ -868,13 +876,7 @@ mod tests {
                 cull.receiver(&scene, origin);
                 culled_walls += scene.objects.len() - cull.tests.len();
                 for h in &hvls {
-                    let to = h.hvl.position().as_dvec3() - origin;
-                    let d = to.length();
-                    let ray = Ray {
-                        o: origin,
-                        d: to / d,
-                    };
-                    let t_max = d * (1.0 - f64::from(SHADOW_EPS));
+                    let (ray, t_max) = shadow_ray(origin, h);
                     let all = scene.occluded(&ray, 0.0, t_max);
                     let some = cull.blocked(&scene, &ray, t_max);
                     assert_eq!(all, some, "HVL on object {} from {origin}", h.object);

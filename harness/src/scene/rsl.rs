@@ -263,22 +263,20 @@ pub fn choose_k(scene: &Scene, o: &Options, target: f64) -> Result<KChoice, Stri
     // The visibility-map side with the chosen K's lights.
     let pos = order.iter().position(|&c| c == k).unwrap_or(0);
     b.lights = lights_of.swap_remove(pos);
+    // The probes shaded with the chosen K's lights and the maps of `os`.
+    let shaded = |os: &Options| -> Vec<Rgb> {
+        let mut cov = vec![0.0f32; os.vis_side * os.vis_side];
+        points
+            .iter()
+            .map(|p| match point_moments(scene, os, p, &mut cov) {
+                Some((frame, m)) => shade_with(scene, &b, p, &frame, &m),
+                None => [0.0; 3],
+            })
+            .collect()
+    };
     let side_images: Vec<Vec<Rgb>> = VIS_SIDE_CANDIDATES
         .iter()
-        .map(|&side| {
-            let os = Options {
-                vis_side: side,
-                ..*o
-            };
-            let mut cov = vec![0.0f32; side * side];
-            points
-                .iter()
-                .map(|p| match point_moments(scene, &os, p, &mut cov) {
-                    Some((frame, m)) => shade_with(scene, &b, p, &frame, &m),
-                    None => [0.0; 3],
-                })
-                .collect()
-        })
+        .map(|&vis_side| shaded(&Options { vis_side, ..*o }))
         .collect();
     let (vis_side, side_estimates) = super::plan_choice(&VIS_SIDE_CANDIDATES, &side_images, target)
         .ok_or("no visibility-map side")?;
@@ -287,19 +285,11 @@ pub fn choose_k(scene: &Scene, o: &Options, target: f64) -> Result<KChoice, Stri
     let depth_images: Vec<Vec<Rgb>> = depths
         .iter()
         .map(|&vis_depth| {
-            let os = Options {
+            shaded(&Options {
                 vis_side,
                 vis_depth,
                 ..*o
-            };
-            let mut cov = vec![0.0f32; vis_side * vis_side];
-            points
-                .iter()
-                .map(|p| match point_moments(scene, &os, p, &mut cov) {
-                    Some((frame, m)) => shade_with(scene, &b, p, &frame, &m),
-                    None => [0.0; 3],
-                })
-                .collect()
+            })
         })
         .collect();
     let (vis_depth, depth_estimates) =
