@@ -18,8 +18,9 @@ pub(crate) fn check_side(what: &'static str, n: usize, max: usize) -> Result<(),
     Ok(())
 }
 
-/// `Err` unless a slice length `got` is exactly `want`.
-pub(crate) fn check_len(what: &'static str, got: usize, want: usize) -> Result<(), Error> {
+/// `Err` unless a slice length `got` is exactly `want` (`what` names the slice); the one
+/// length check of the kernels, their SIMD twins included.
+pub fn check_len(what: &'static str, got: usize, want: usize) -> Result<(), Error> {
     if got != want {
         return Err(Error::OutOfRange {
             what,

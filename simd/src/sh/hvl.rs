@@ -12,6 +12,7 @@
 //! speed of the scalar kernel at 3–9 bands (`steradian report --section sh`, `hvl_ns[]`),
 //! where the geometry done lane by lane leaves [`contributions`] 1.2–1.7 times faster.
 
+use steradian_core::grid::check_len;
 use steradian_core::sh::hvl::{
     Horizon, Hvl, Prepared, Receiver, ZonalReceiver, contribution_zonal, prepare,
 };
@@ -73,19 +74,6 @@ pub fn contributions_x4(
     Ok(core::array::from_fn(|k| value[k].unwrap_or(r[k])))
 }
 
-/// One output per HVL.
-fn check_out(hvls: &[Hvl], out: &[f32]) -> Result<(), Error> {
-    if out.len() != hvls.len() {
-        return Err(Error::OutOfRange {
-            what: "HVL output length",
-            value: out.len() as f32,
-            min: hvls.len() as f32,
-            max: hvls.len() as f32,
-        });
-    }
-    Ok(())
-}
-
 /// [`contributions_x4`] over a slice of HVLs: `out[j]` is HVL `j`'s contribution to `rx`.
 /// Any length (the tail repeats the last HVL and is not written).
 ///
@@ -98,7 +86,7 @@ pub fn contributions(
     scratch: &mut [[f32; 4]],
     out: &mut [f32],
 ) -> Result<(), Error> {
-    check_out(hvls, out)?;
+    check_len("HVL output length", out.len(), hvls.len())?;
     for (group, out) in hvls.chunks(4).zip(out.chunks_mut(4)) {
         let four: [&Hvl; 4] = core::array::from_fn(|k| &group[k.min(group.len() - 1)]);
         let c = contributions_x4(four, emission, rx, horizon, scratch)?;
@@ -344,7 +332,7 @@ pub fn contributions_zonal(
     scratch: &mut [f32],
     out: &mut [f32],
 ) -> Result<(), Error> {
-    check_out(hvls, out)?;
+    check_len("HVL output length", out.len(), hvls.len())?;
     let Some(first) = hvls.first() else {
         return Ok(());
     };
