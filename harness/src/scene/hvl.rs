@@ -178,10 +178,42 @@ pub struct Scratch {
     diffuse_c: Vec<f32>,
     glossy_c: Vec<Vec<f32>>,
     sh4: Vec<[f32; 4]>,
-    /// The SIMD kernels' contiguous HVLs (refilled per receiver, not reallocated).
-    lights: Vec<core_hvl::Hvl>,
-    /// [`ShadowCull`] of the HVLs last shaded with.
+    /// The objects the current receiver's shadow rays test.
     cull: ShadowCull,
+}
+
+/// A placement of HVLs as receivers shade with it, built once per render: the placed HVLs,
+/// their core HVLs side by side (the SIMD kernels' input), and per scene object how far
+/// behind a plane its farthest HVL lies (`δ = max(0, max_h −n·(h − p))`, a rounding of the
+/// `f32` positions for the HVLs on the plane itself; `∞` for spheres), which
+/// [`ShadowCull`] reads.
+pub struct Placement {
+    /// The placed HVLs.
+    pub placed: Vec<Placed>,
+    lights: Vec<core_hvl::Hvl>,
+    behind: Vec<f64>,
+}
+
+impl Placement {
+    /// The placement of `placed` in `scene`.
+    pub fn new(scene: &Scene, placed: Vec<Placed>) -> Placement {
+        let lights = placed.iter().map(|h| h.hvl).collect();
+        let behind = scene
+            .objects
+            .iter()
+            .map(|obj| match obj.shape {
+                Shape::Plane { point, normal } => placed.iter().fold(0.0, |m: f64, h| {
+                    m.max(-normal.dot(h.hvl.position().as_dvec3() - point))
+                }),
+                Shape::Sphere { .. } => f64::INFINITY,
+            })
+            .collect();
+        Placement {
+            placed,
+            lights,
+            behind,
+        }
+    }
 }
 
 /// The shadow ray from a receiver's `origin` toward an HVL, unit direction, and its end
@@ -198,10 +230,8 @@ fn shadow_ray(origin: DVec3, h: &Placed) -> (Ray, f64) {
     )
 }
 
-/// What the shadow rays toward one placement of HVLs can leave out: per scene object, how
-/// far behind a plane its farthest HVL lies (`δ = max(0, max_h −n·(h − p))`, a rounding
-/// of the `f32` positions for the HVLs on the plane itself; `∞` for spheres), and the
-/// objects a receiver tests (refilled per receiver). From an origin in front of a plane by
+/// The objects the shadow rays from one receiver toward a [`Placement`] test (refilled per
+/// receiver). From an origin in front of a plane by
 /// `s > 2δ/ε`, a segment toward an HVL crosses the plane, if at all, beyond the fraction
 /// `s/(s + δ) > 1 − ε/2` of its length (`n·(x − p)` is linear along it), past the ray's
 /// `t_max`, which stops `ε = 1e-4` short of the HVL (far above the rounding of the hit
@@ -215,39 +245,20 @@ fn shadow_ray(origin: DVec3, h: &Placed) -> (Ray, f64) {
 /// sphere's distance, far above the rounding of either side.
 #[derive(Default)]
 struct ShadowCull {
-    /// The placement the depths are of: its first HVL's address and its length.
-    of: (usize, usize),
-    behind: Vec<f64>,
     /// Per tested object: its index, and for a sphere `c − o` and the cone's threshold
     /// (`−∞` where the receiver is inside or the object is a plane).
     tests: Vec<(usize, DVec3, f64)>,
 }
 
 impl ShadowCull {
-    /// The depths for `hvls` (computed once per placement).
-    fn prepare(&mut self, scene: &Scene, hvls: &[Placed]) {
-        let key = (hvls.as_ptr() as usize, hvls.len());
-        if self.of == key && self.behind.len() == scene.objects.len() {
-            return;
-        }
-        self.of = key;
-        self.behind.clear();
-        self.behind
-            .extend(scene.objects.iter().map(|obj| match obj.shape {
-                Shape::Plane { point, normal } => hvls.iter().fold(0.0, |m: f64, h| {
-                    m.max(-normal.dot(h.hvl.position().as_dvec3() - point))
-                }),
-                Shape::Sphere { .. } => f64::INFINITY,
-            }));
-    }
-
-    /// The objects a shadow ray from `origin` tests, in `self.tests`.
-    fn receiver(&mut self, scene: &Scene, origin: DVec3) {
+    /// The objects a shadow ray from `origin` toward the HVLs of `at` tests, in
+    /// `self.tests`.
+    fn receiver(&mut self, scene: &Scene, at: &Placement, origin: DVec3) {
         self.tests.clear();
         for (id, obj) in scene.objects.iter().enumerate() {
             match obj.shape {
                 Shape::Plane { point, normal } => {
-                    if self.behind[id] >= 0.5 * f64::from(SHADOW_EPS) * normal.dot(origin - point) {
+                    if at.behind[id] >= 0.5 * f64::from(SHADOW_EPS) * normal.dot(origin - point) {
                         self.tests.push((id, DVec3::ZERO, f64::NEG_INFINITY));
                     }
                 }
@@ -285,7 +296,6 @@ impl Default for Scratch {
             diffuse_c: Vec::new(),
             glossy_c: Vec::new(),
             sh4: Vec::new(),
-            lights: Vec::new(),
             cull: ShadowCull::default(),
         }
     }
@@ -406,12 +416,12 @@ pub struct GlossyViews<'a> {
 pub fn indirect(
     scene: &Scene,
     p: &ShadingPoint,
-    hvls: &[Placed],
+    at: &Placement,
     o: &Options,
     glossy: &GlossyViews<'_>,
     scratch: &mut Scratch,
 ) -> Rgb {
-    indirect_parts(scene, p, hvls, o, glossy, true, scratch)
+    indirect_parts(scene, p, at, o, glossy, true, scratch)
 }
 
 /// A receiver's view frame and `θₒ`, with the first `n` (clamped to 1 ..= the committed
@@ -442,7 +452,7 @@ fn lambert_zonal(
 fn indirect_parts(
     scene: &Scene,
     p: &ShadingPoint,
-    hvls: &[Placed],
+    at: &Placement,
     o: &Options,
     glossy: &GlossyViews<'_>,
     diffuse: bool,
@@ -465,7 +475,6 @@ fn indirect_parts(
         diffuse_c,
         glossy_c,
         sh4,
-        lights,
         cull,
     } = scratch;
     let Some((frame, theta, n)) = lambert_zonal(p, o.bands, coeffs, zonal) else {
@@ -494,11 +503,9 @@ fn indirect_parts(
     };
     let emission = core_hvl::lambert_emission(1.0);
     // The SIMD path: every HVL's share of each part first, batched.
+    let (lights, hvls) = (&at.lights[..], &at.placed[..]);
     let batched = o.simd && !hvls.is_empty();
     if batched {
-        lights.clear();
-        lights.extend(hvls.iter().map(|h| h.hvl));
-        let lights = &lights[..];
         let horizon = core_hvl::Horizon::Smoothstep;
         diffuse_c.resize(hvls.len(), 0.0);
         if !diffuse
@@ -530,8 +537,7 @@ fn indirect_parts(
     }
     let origin = path::offset(p.x, p.n);
     if o.visibility {
-        cull.prepare(scene, hvls);
-        cull.receiver(scene, origin);
+        cull.receiver(scene, at, origin);
     }
     let mut acc = [0.0f64; 3];
     let mut gacc = [[0.0f64; 3]; super::material::MAX_LOBES];
@@ -660,13 +666,14 @@ pub fn render_gpu(
         Glossy::none(scene)
     };
     let views = glossy.views();
-    let hvls = place(scene, o.side);
+    let at = Placement::new(scene, place(scene, o.side));
+    let hvls = &at.placed;
     let nb = o.bands.clamp(1, brdf::lambert().bands());
-    let table = gpu_sum_table(scene, &hvls, nb, o.visibility);
+    let table = gpu_sum_table(scene, hvls, nb, o.visibility);
     let new_state = || (ProductCounts::default(), Scratch::default());
     let (mut img, _) = render_centres(scene, bar, new_state, |(counts, scratch), p| {
         let d = lobes::shade(scene, p, &o.direct, counts);
-        let g = indirect_parts(scene, p, &hvls, o, &views, false, scratch);
+        let g = indirect_parts(scene, p, &at, o, &views, false, scratch);
         [d[0] + g[0], d[1] + g[1], d[2] + g[2]]
     });
     // The receivers with a diffuse part: pixel, albedo and the kernel's input row.
@@ -773,13 +780,14 @@ fn probe_images<T: Copy>(
     candidates
         .iter()
         .map(|&c| {
-            let (hvls, bands) = setting(c);
+            let (placed, bands) = setting(c);
+            let at = Placement::new(scene, placed);
             let oc = Options { bands, ..*o };
             probes
                 .iter()
                 .zip(&direct)
                 .map(|(p, d)| {
-                    let i = indirect(scene, p, &hvls, &oc, &glossy, &mut scratch);
+                    let i = indirect(scene, p, &at, &oc, &glossy, &mut scratch);
                     [d[0] + i[0], d[1] + i[1], d[2] + i[2]]
                 })
                 .collect()
@@ -815,7 +823,7 @@ pub fn choose_bands(scene: &Scene, o: &Options, target: f64) -> BandsChoice {
 /// Direct light by the `lobes` method plus one bounce from HVLs, one pixel-centre sample
 /// per pixel ([`super::render_centres`]); returns the image and the HVL count.
 pub fn render(scene: &Scene, o: &Options, bar: &ProgressBar) -> (Image, usize) {
-    let hvls = place(scene, o.side);
+    let at = Placement::new(scene, place(scene, o.side));
     let glossy = if o.glossy {
         Glossy::build(scene)
     } else {
@@ -828,18 +836,18 @@ pub fn render(scene: &Scene, o: &Options, bar: &ProgressBar) -> (Image, usize) {
         super::render_centres_x8(scene, bar, new_state, |(counts, scratch), ps, out| {
             lobes::shade_x8(scene, ps, &o.direct, counts, out);
             for (p, d) in ps.iter().zip(out.iter_mut()) {
-                let ind = indirect(scene, p, &hvls, o, &glossy, scratch);
+                let ind = indirect(scene, p, &at, o, &glossy, scratch);
                 *d = [d[0] + ind[0], d[1] + ind[1], d[2] + ind[2]];
             }
         })
     } else {
         render_centres(scene, bar, new_state, |(counts, scratch), p| {
             let d = lobes::shade(scene, p, &o.direct, counts);
-            let ind = indirect(scene, p, &hvls, o, &glossy, scratch);
+            let ind = indirect(scene, p, &at, o, &glossy, scratch);
             [d[0] + ind[0], d[1] + ind[1], d[2] + ind[2]]
         })
     };
-    (img, hvls.len())
+    (img, at.placed.len())
 }
 
 #[cfg(test)]
@@ -867,15 +875,14 @@ mod tests {
             flipped,
             Scene::load("builtin:lobes").unwrap(),
         ] {
-            let hvls = place(&scene, 4);
+            let at = Placement::new(&scene, place(&scene, 4));
             let mut cull = ShadowCull::default();
             let (mut pairs, mut blocked) = (0, 0);
             for p in super::super::probe_points(&scene) {
                 let origin = path::offset(p.x, p.n);
-                cull.prepare(&scene, &hvls);
-                cull.receiver(&scene, origin);
+                cull.receiver(&scene, &at, origin);
                 culled_walls += scene.objects.len() - cull.tests.len();
-                for h in &hvls {
+                for h in &at.placed {
                     let (ray, t_max) = shadow_ray(origin, h);
                     let all = scene.occluded(&ray, 0.0, t_max);
                     let some = cull.blocked(&scene, &ray, t_max);
