@@ -274,15 +274,16 @@ pub fn choose_k(scene: &Scene, o: &Options, target: f64) -> Result<KChoice, Stri
             })
             .collect()
     };
-    let side_images: Vec<Vec<Rgb>> = VIS_SIDE_CANDIDATES
+    let mut side_images: Vec<Vec<Rgb>> = VIS_SIDE_CANDIDATES
         .iter()
         .map(|&vis_side| shaded(&Options { vis_side, ..*o }))
         .collect();
     let (vis_side, side_estimates) = super::plan_choice(&VIS_SIDE_CANDIDATES, &side_images, target)
         .ok_or("no visibility-map side")?;
-    // The coverage depth with the chosen K and side.
+    // The coverage depth with the chosen K and side; the deepest (`o.vis_depth`) is the
+    // chosen side's image above.
     let depths: Vec<u32> = (0..=o.vis_depth).collect();
-    let depth_images: Vec<Vec<Rgb>> = depths
+    let mut depth_images: Vec<Vec<Rgb>> = depths[..depths.len() - 1]
         .iter()
         .map(|&vis_depth| {
             shaded(&Options {
@@ -292,6 +293,11 @@ pub fn choose_k(scene: &Scene, o: &Options, target: f64) -> Result<KChoice, Stri
             })
         })
         .collect();
+    let side_pos = VIS_SIDE_CANDIDATES
+        .iter()
+        .position(|&c| c == vis_side)
+        .unwrap_or(0);
+    depth_images.push(side_images.swap_remove(side_pos));
     let (vis_depth, depth_estimates) =
         super::plan_choice(&depths, &depth_images, target).ok_or("no coverage depth")?;
     // The cube-map face with the chosen K, side and depth (the SATs shared, fitted above).
