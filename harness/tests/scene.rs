@@ -987,9 +987,8 @@ fn lobes_plans_the_quadtree_depth_from_the_target_error() {
             m.mean_abs_over_max,
             deep.mean_abs_over_max
         );
-        // The whole render is within the target on both scenes (`cluster` at 2.6e-3 of its
-        // 2.8e-3, most of it pixels whose small spheres and shadow edges the reference's
-        // box filter averages and a pixel-centre method does not).
+        // The whole render is within the target on both scenes (`cluster` measured at
+        // 2.6e-3 of its 2.8e-3).
         assert!(
             m.mean_abs_over_max < target + 4.0 * m.reference_noise_over_max,
             "{name}: {m:?}"
