@@ -410,6 +410,16 @@ mod tests {
         assert!(coverage_into(&[], 4, Outside::Visible, &mut out[..15]).is_err());
     }
 
+    /// Uniform `[0, 1)` values from a xorshift stream seeded with `seed`.
+    fn uniform(mut seed: u64) -> impl FnMut() -> f32 {
+        move || {
+            seed ^= seed << 13;
+            seed ^= seed >> 7;
+            seed ^= seed << 17;
+            (seed >> 40) as f32 / (1u64 << 24) as f32
+        }
+    }
+
     /// `cap_bound` bounds the change of a cap's `f` over a square: for caps from 1e-3 rad to
     /// a hemisphere, square centres over the whole parametrisation square (outside the disk
     /// too), half-diagonals from a leaf's to a whole-map block's, and points across the
@@ -417,13 +427,7 @@ mod tests {
     /// `LIP_CAP·h` near a small cap.
     #[test]
     fn cap_bound_bounds_the_cap_function_over_a_square() {
-        let mut seed = 0x9e37_79b9_7f4a_7c15u64;
-        let mut r = || {
-            seed ^= seed << 13;
-            seed ^= seed >> 7;
-            seed ^= seed << 17;
-            (seed >> 40) as f32 / (1u64 << 24) as f32
-        };
+        let mut r = uniform(0x9e37_79b9_7f4a_7c15);
         let mut tighter = 0;
         for trial in 0..4000 {
             let a = Vec3::new(2.0 * r() - 1.0, 2.0 * r() - 1.0, 2.0 * r() - 0.5);
@@ -451,13 +455,7 @@ mod tests {
     /// The block walk gives each texel what `area` gives it alone.
     #[test]
     fn block_walk_matches_texel_by_texel() {
-        let mut seed = 0x2545_f491_4f6c_dd1du64;
-        let mut r = || {
-            seed ^= seed << 13;
-            seed ^= seed >> 7;
-            seed ^= seed << 17;
-            (seed >> 40) as f32 / (1u64 << 24) as f32
-        };
+        let mut r = uniform(0x2545_f491_4f6c_dd1d);
         let mut worst = 0.0f32;
         for trial in 0..60 {
             let caps: [SphericalCap; 4] = core::array::from_fn(|_| {
