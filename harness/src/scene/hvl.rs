@@ -185,8 +185,8 @@ pub struct Scratch {
 /// A placement of HVLs as receivers shade with it, built once per render: the placed HVLs,
 /// their core HVLs side by side (the SIMD kernels' input), and per scene object how far
 /// behind a plane its farthest HVL lies (`δ = max(0, max_h −n·(h − p))`, a rounding of the
-/// `f32` positions for the HVLs on the plane itself; `∞` for spheres), which
-/// [`ShadowCull`] reads.
+/// `f32` positions for the HVLs on the plane itself; `∞` for spheres), from which the
+/// shadow rays leave out planes no segment can cross.
 pub struct Placement {
     /// The placed HVLs.
     pub placed: Vec<Placed>,
