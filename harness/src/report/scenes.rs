@@ -4,8 +4,9 @@
 //! path tracer would need N× longer for the same error".
 //!
 //! Per scene of [`SCENES`] (at [`WIDTH`] columns): the reference is the path tracer at
-//! [`REFERENCE_SPP`] samples per pixel ([`ENVIRONMENT_REFERENCE_SPP`] for `environment`,
-//! whose reference is the noisiest per sample), direct light for `lobes` and `cluster` and
+//! [`REFERENCE_SPP`] samples per pixel ([`ROOM_REFERENCE_SPP`] for `room` and
+//! [`ENVIRONMENT_REFERENCE_SPP`] for `environment`, whose references are the noisiest per
+//! sample), direct light for `lobes` and `cluster` and
 //! one bounce for `room`; the path tracer's curve is the same tracer with other seeds at
 //! [`PATH_SPP`] samples. The default point of `lobes` and `hvl` is what `steradian render`
 //! plans at the default target error (`planned`); that of `rsl` is its plan with `K` set
@@ -41,18 +42,26 @@ use crate::scene::{Scene, Seen, hvl, lobes, path, render, rsl};
 
 /// Image width of the section's renders (the height follows each scene's aspect ratio).
 pub const WIDTH: u32 = 96;
-/// Samples per pixel of the reference.
-pub const REFERENCE_SPP: u32 = 512;
-/// Samples per pixel of the `environment` reference: at [`REFERENCE_SPP`] its noise
+/// Samples per pixel of the `lobes` and `cluster` references. At 512 their noise
+/// (`reference_noise_over_max`) was half the `lobes` method's error (2.8e-4 against
+/// 5.4e-4 of max on `lobes`, 8.3e-4 against 1.55e-3 on `cluster`): a noisy reference
+/// inflates the method's error and the path tracer's alike, and the path tracer's curve,
+/// extrapolated as `spp^−½` from a point that carries that noise, then reaches the method's
+/// error in too few samples.
+pub const REFERENCE_SPP: u32 = 2048;
+/// Samples per pixel of the `room` reference (one bounce): at 512 its noise was 1.3e-3 of
+/// max against the `hvl` method's 1.38e-3, so the method's error was mostly the reference's.
+pub const ROOM_REFERENCE_SPP: u32 = 4096;
+/// Samples per pixel of the `environment` reference: at 512 its noise
 /// (`reference_noise_over_max` in the report) was as large as the `rsl` method's error.
 pub const ENVIRONMENT_REFERENCE_SPP: u32 = 4096;
 
 /// The reference's samples per pixel for a scene.
 fn reference_spp(name: &str) -> u32 {
-    if name == "environment" {
-        ENVIRONMENT_REFERENCE_SPP
-    } else {
-        REFERENCE_SPP
+    match name {
+        "environment" => ENVIRONMENT_REFERENCE_SPP,
+        "room" => ROOM_REFERENCE_SPP,
+        _ => REFERENCE_SPP,
     }
 }
 /// Samples per pixel of the path tracer's own curve.
@@ -647,7 +656,7 @@ pub fn section(opts: &Options) -> Result<Section, Box<dyn Error>> {
     writeln!(
         html,
         "<p>Built-in scenes at {WIDTH} columns. Reference: the path tracer at {REFERENCE_SPP} \
-         samples per pixel ({ENVIRONMENT_REFERENCE_SPP} on <code>environment</code>; direct light; one bounce for <code>room</code>). Errors over shaded, \
+         samples per pixel ({ROOM_REFERENCE_SPP} on <code>room</code>, {ENVIRONMENT_REFERENCE_SPP} on <code>environment</code>; direct light; one bounce for <code>room</code>). Errors over shaded, \
          non-silhouette pixels (see the README, \"Errors\"); times are whole renders on this \
          machine's thread pool, the best of at least three runs repeated for 0.25 s, the \
          path tracer's and the methods' alike. wgpu: {}.</p>",
