@@ -18,7 +18,9 @@
 //! `e_w(n)² = (‖F‖² − Σ_l (2w_l − w_l²) Σ_m F_l^m²)/‖F‖²`. [`choose_bands`] takes the
 //! fewest bands (3..=16) with `e(n) ≤ target` at `θₒ = 45°`, and [`choose_samples`] the
 //! fewest views (from 16, 23, 30, 45, 90, 180) whose linear interpolation misses the
-//! coefficients at the midpoints by at most `target/10` of their norm.
+//! coefficients at the midpoints by at most `target/10` of their norm; [`choose_table`]
+//! makes the same choice testing the midpoints from the grazing end and stopping at the
+//! first miss, and encodes the table from the views it projected on the way.
 
 use rayon::prelude::*;
 use steradian_core::sh::brdf::{self, BrdfSh, Part, TABLE_NAME, stored};
@@ -191,47 +193,102 @@ pub fn theta(k: usize, samples: usize) -> f64 {
     (k as f64 + 0.5) * std::f64::consts::FRAC_PI_2 / samples as f64
 }
 
-/// The fewest views with interpolation error at most `target/10` (module docs).
-pub fn choose_samples(model: &Model, bands: usize, target: f64) -> usize {
-    let nodes = Nodes::new(model.feature_angle(), bands, 1);
-    for t in [16usize, 23, 30, 45, 90] {
-        let at: Vec<Vec<f64>> = (0..t)
-            .into_par_iter()
-            .map(|k| project(model, &nodes, theta(k, t)).0)
+/// View counts [`choose_samples`] tries, in order (180 where none is enough).
+pub const SAMPLE_COUNTS: [usize; 5] = [16, 23, 30, 45, 90];
+
+/// `(F, F′)` of one view.
+type View = (Vec<f64>, Vec<f64>);
+
+/// Whether `t` views interpolate within `target/10` at every midpoint (module docs), and
+/// the views computed on the way: all `t` of them where it does.
+///
+/// The midpoints are tested from the grazing end, a few at a time (in parallel), and the
+/// test stops at the first chunk with a miss: the decision is the same as testing them all,
+/// and a count that fails usually fails near grazing, where `F` changes fastest, after a
+/// handful of projections instead of `2t − 1`.
+fn interpolates(model: &Model, nodes: &Nodes, t: usize, target: f64) -> (bool, Vec<Option<View>>) {
+    let mut views: Vec<Option<View>> = vec![None; t];
+    let chunk = 2 * rayon::current_num_threads().max(1);
+    let mids: Vec<usize> = (0..t - 1).rev().collect();
+    for ks in mids.chunks(chunk) {
+        // The views these midpoints need, then the midpoints themselves.
+        let need: Vec<usize> = (ks[ks.len() - 1]..=ks[0] + 1)
+            .filter(|&k| views[k].is_none())
             .collect();
-        let worst = (0..t - 1)
+        let got: Vec<(usize, View)> = need
             .into_par_iter()
             .map(|k| {
-                let mid = project(model, &nodes, 0.5 * (theta(k, t) + theta(k + 1, t))).0;
+                let (f, fp, _, _) = project(model, nodes, theta(k, t));
+                (k, (f, fp))
+            })
+            .collect();
+        for (k, v) in got {
+            views[k] = Some(v);
+        }
+        let seen = &views;
+        let worst = ks
+            .par_iter()
+            .map(|&k| {
+                let mid = project(model, nodes, 0.5 * (theta(k, t) + theta(k + 1, t))).0;
+                let (Some(a), Some(b)) = (&seen[k], &seen[k + 1]) else {
+                    return f64::INFINITY;
+                };
                 let err: f64 = mid
                     .iter()
-                    .zip(at[k].iter().zip(&at[k + 1]))
+                    .zip(a.0.iter().zip(&b.0))
                     .map(|(m, (a, b))| (m - 0.5 * (a + b)).powi(2))
                     .sum();
                 let norm: f64 = mid.iter().map(|m| m * m).sum();
                 (err / norm.max(1e-300)).sqrt()
             })
             .reduce(|| 0.0, f64::max);
-        if worst <= target / 10.0 {
-            return t;
+        if worst > target / 10.0 {
+            return (false, views);
         }
     }
-    180
+    (true, views)
+}
+
+/// The fewest views of [`SAMPLE_COUNTS`] with interpolation error at most `target/10`
+/// (module docs), 180 where none is enough.
+pub fn choose_samples(model: &Model, bands: usize, target: f64) -> usize {
+    choose_table(model, bands, target).0
+}
+
+/// [`choose_samples`] and the [`table`] of that many views (file bytes), from the views the
+/// choice projected already: the same bytes as `table(model, bands, choose_samples(..))`
+/// (the same projections, each computed once).
+pub fn choose_table(model: &Model, bands: usize, target: f64) -> (usize, Vec<u8>) {
+    let nodes = Nodes::new(model.feature_angle(), bands, 1);
+    for t in SAMPLE_COUNTS {
+        let (ok, views) = interpolates(model, &nodes, t, target);
+        if ok {
+            let views: Vec<View> = views.into_iter().flatten().collect();
+            return (t, encode_views(bands, &views));
+        }
+    }
+    (180, table(model, bands, 180))
 }
 
 /// The table of `model` with `bands` bands and `samples` views (file bytes).
 pub fn table(model: &Model, bands: usize, samples: usize) -> Vec<u8> {
     let nodes = Nodes::new(model.feature_angle(), bands, 1);
-    let ns = stored(bands);
-    let views: Vec<(Vec<f64>, Vec<f64>)> = (0..samples)
+    let views: Vec<View> = (0..samples)
         .into_par_iter()
         .map(|k| {
             let (f, fp, _, _) = project(model, &nodes, theta(k, samples));
             (f, fp)
         })
         .collect();
+    encode_views(bands, &views)
+}
+
+/// The table file of the views `(F, F′)` at `θ_k` ([`theta`]), `k = 0..views.len()`.
+fn encode_views(bands: usize, views: &[View]) -> Vec<u8> {
+    let ns = stored(bands);
+    let samples = views.len();
     let mut values = Vec::with_capacity(samples * 2 * ns);
-    for (f, fp) in &views {
+    for (f, fp) in views {
         values.extend(f.iter().map(|&v| v as f32));
         values.extend(fp.iter().map(|&v| v as f32));
     }
@@ -333,8 +390,7 @@ pub fn materials() -> [Material; 4] {
 fn builtin(k: usize) -> Vec<u8> {
     let m = &materials()[k];
     let bands = choose_bands(&m.model, TARGET).max(3);
-    let samples = choose_samples(&m.model, bands, TARGET);
-    table(&m.model, bands, samples)
+    choose_table(&m.model, bands, TARGET).1
 }
 
 /// `brdf_lambert.bin`.

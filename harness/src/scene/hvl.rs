@@ -358,8 +358,7 @@ impl Glossy {
                 return Some(bytes.clone());
             }
             let n = gen_sh::choose_bands(&model, GLOSSY_TARGET);
-            let t = gen_sh::choose_samples(&model, n, GLOSSY_TARGET);
-            let bytes = gen_sh::table(&model, n, t);
+            let (_, bytes) = gen_sh::choose_table(&model, n, GLOSSY_TARGET);
             built.push((key, bytes.clone()));
             Some(bytes)
         };
