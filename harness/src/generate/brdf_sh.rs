@@ -113,23 +113,31 @@ pub fn project(model: &Model, nodes: &Nodes, theta_o: f64) -> (Vec<f64>, Vec<f64
     let (mut f, mut fp) = (vec![0.0; ns], vec![0.0; ns]);
     let (mut nf, mut nfp) = (0.0, 0.0);
     let (mut g, mut gp) = (vec![0.0; n], vec![0.0; n]);
-    // The azimuths' (sin, cos), the same at every `θ` node.
-    let phis: Vec<(f64, f64)> = (0..nphi)
-        .map(|j| ((j as f64 + 0.5) * dphi).sin_cos())
+    // The azimuths' (sin, cos, weight), the same at every `θ` node. The view is in the
+    // xz-plane, so the BRDF is even in `φ` (`ρ(φ) = ρ(−φ)`, as is `cos mφ`): the midpoint
+    // nodes `φ` and `2π − φ` pair up as one node of weight 2 (`φ = π`, the middle node of
+    // an odd count, is its own partner: weight 1). Half the BRDF evaluations.
+    let phis: Vec<(f64, f64, f64)> = (0..nphi.div_ceil(2))
+        .map(|j| {
+            let (sp, cp) = ((j as f64 + 0.5) * dphi).sin_cos();
+            let w = if 2 * j + 1 == nphi { 1.0 } else { 2.0 };
+            (sp, cp, w)
+        })
         .collect();
     for (k, &(t, wt)) in nodes.theta.iter().enumerate() {
         let (s, c) = t.sin_cos();
         g.fill(0.0);
         gp.fill(0.0);
         let (mut sq, mut sqp) = (0.0, 0.0);
-        for &(sp, cp) in &phis {
+        for &(sp, cp, w) in &phis {
             let rho = model.rho([s * cp, s * sp, c], wo);
             if rho == 0.0 {
                 continue;
             }
             let (a, b) = (rho * c, rho);
-            sq += a * a;
-            sqp += b * b;
+            sq += w * (a * a);
+            sqp += w * (b * b);
+            let (a, b) = (w * a, w * b);
             // cos mφ by the Chebyshev recurrence.
             let (mut c0, mut c1) = (1.0f64, cp);
             for m in 0..n {
