@@ -1092,6 +1092,59 @@ fn lobes_plans_the_quadtree_depth_from_the_target_error() {
     }
 }
 
+/// `--target-error` plans the lobe-product table (`choose_table`): the plan takes the
+/// coarsest size whose probe estimate is within `PLAN_SHARE` of the target (the sizes
+/// before it are not), which at the default target is the 12 × 12 × 16 table on `lobes`
+/// and `cluster` (5 KB in place of the committed 1.06 MB); the whole image with it stays
+/// within that share of the built-in table's image; a tiny target takes a finer table.
+#[test]
+fn lobes_plans_the_product_table_from_the_target_error() {
+    use lobes::TableSize;
+    let hidden = ProgressBar::hidden();
+    let target = render::DEFAULT_TARGET_ERROR;
+    for name in ["lobes", "cluster"] {
+        let small = Small::new(name, 64, 16, 0);
+        let planned = plan_at(&small.scene, render::Method::Lobes, target).lobes;
+        let c = lobes::choose_table(&small.scene, &lobes::Options::default(), target);
+        eprintln!("{name}: {:?} {:?}", c.size, c.estimates);
+        assert_eq!(planned.table, c.size);
+        assert_eq!(c.size, TableSize::E12, "{name}: {:?}", c.estimates);
+        let (last, before) = c.estimates.split_last().unwrap();
+        assert_eq!(last.0, c.size);
+        assert!(last.1 <= scene::PLAN_SHARE * target, "{:?}", c.estimates);
+        assert!(before.iter().all(|e| e.1 > scene::PLAN_SHARE * target));
+        // The image with the planned table against the built-in table's.
+        let (img, _) = lobes::render(&small.scene, &planned, &hidden);
+        let builtin = lobes::Options {
+            table: TableSize::BuiltIn,
+            ..planned
+        };
+        let (reference, _) = lobes::render(&small.scene, &builtin, &hidden);
+        let (w, h) = (
+            small.scene.camera.width as usize,
+            small.scene.camera.height as usize,
+        );
+        let (mut sum, mut max) = (0.0f64, 0.0f64);
+        for j in 0..h {
+            for i in 0..w {
+                let (a, b) = (img.get(i, j), reference.get(i, j));
+                for c in 0..3 {
+                    sum += (a[c] - b[c]).abs();
+                    max = max.max(b[c]);
+                }
+            }
+        }
+        let mean = sum / (3 * w * h) as f64 / max;
+        eprintln!("{name}: planned table against the built-in one: {mean:.2e} of max");
+        assert!(mean <= scene::PLAN_SHARE * target, "{name}: {mean}");
+    }
+    // A tiny target: the 12 × 12 × 16 table's estimate (about 1.5e-5 on `lobes`) is above
+    // its share, so a finer table is taken.
+    let small = Small::new("lobes", 64, 16, 0);
+    let tight = plan_at(&small.scene, render::Method::Lobes, 1e-6).lobes;
+    assert!(tight.table > TableSize::E12, "{:?}", tight.table);
+}
+
 /// `--target-error` plans the `hvl` count: the probe estimates fall to 0 at the largest
 /// face side, the plan takes the first within `PLAN_SHARE` of the target, a loose target takes fewer
 /// HVLs and a tiny one the most; the planned count stays within the target against the

@@ -9,7 +9,8 @@
 //! sample), direct light for `lobes` and `cluster` and
 //! one bounce for `room`; the path tracer's curve is the same tracer with other seeds at
 //! [`PATH_SPP`] samples. The default point of `lobes` and `hvl` is what `steradian render`
-//! plans at the default target error (`planned`); that of `rsl` is its plan with `K` set
+//! plans at the default target error (`planned`: the product table among its choices, the
+//! built-in table a `lobes` variant); that of `rsl` is its plan with `K` set
 //! to the paper's 30 (its curve sweeps `K` at the plan's cube face, visibility side and
 //! coverage depth). Every method renders with its SIMD path (the default of `steradian
 //! render`), its scalar path at the default setting a variant. The
@@ -302,6 +303,18 @@ fn lobes_settings(scene: &Scene) -> (Vec<Setting<'_>>, Vec<Setting<'_>>) {
             format!("one lobe per occluder, t = {:.0e}", d.threshold),
             lobes::Options {
                 visibility: lobes::Visibility::PerOccluder,
+                ..d
+            },
+            false,
+        ),
+        mk(
+            format!(
+                "built-in product table ({}), t = {:.0e}, depth {depth}",
+                lobes::TableSize::BuiltIn,
+                d.threshold
+            ),
+            lobes::Options {
+                table: lobes::TableSize::BuiltIn,
                 ..d
             },
             false,

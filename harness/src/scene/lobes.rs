@@ -1,10 +1,11 @@
 //! The `lobes` method (cosine-lobe paper, sections 5–5.4): direct lighting from spherical
 //! lights as `∫ f_r·L·V·cos` with every factor a cosine lobe, evaluated by
-//! [`steradian_core::lobe::sum::triple`] with the built-in product table.
+//! [`steradian_core::lobe::sum::triple`] (its table-parameterised `triple_with`) with the
+//! product table of [`Options::table`].
 //!
 //! Per shading point `x` with normal `n`, view `ωo`, and per spherical light:
 //! - the light is the cap it subtends, as one lobe ([`SphericalCap::lobe`], eq. 31–32),
-//!   multiplied by the cosine first ([`Cosine::WithLight`]); energy-preserving by default
+//!   multiplied by the cosine first (core's `Cosine::WithLight`); energy-preserving by default
 //!   (see [`Options::fit`]);
 //! - the reflectance is the material's constant diffuse term `albedo/π` and one unit lobe
 //!   per glossy lobe (modified Phong: about the mirror direction, `(n+2)/(2π)` carried in
@@ -39,9 +40,8 @@ use indicatif::ProgressBar;
 use steradian_core::lobe::CosineLobe;
 use steradian_core::lobe::cap::{CapFit, SphericalCap};
 use steradian_core::lobe::mask::{self, Leaves};
-use steradian_core::lobe::sum::{
-    Cosine, LobeSum, LobeVec, ProductCounts, light_with_cosine, triple,
-};
+use steradian_core::lobe::product::{ProductFit, ProductTable, product_with};
+use steradian_core::lobe::sum::{LobeSum, LobeVec, ProductCounts, lobe_product_with, triple_with};
 
 use super::image::Image;
 use super::{Kind, Rgb, Scene, ShadingPoint, Shape, render_centres, render_centres_x8};
@@ -85,6 +85,88 @@ pub struct Options {
     /// the path tracer on `lobes` and `cluster` (at most 0.7× the paper's error against a
     /// 4096-sample reference).
     pub exact_diffuse: bool,
+    /// The lobe-product table every product reads ([`TableSize`]): the built-in one by
+    /// default; `steradian render` plans the coarsest that its probes allow.
+    pub table: TableSize,
+}
+
+/// Resolutions of the lobe-product table (`exponents × exponents × angles`, core's
+/// [`steradian_core::lobe::product`] format): three generated at run time by the harness's
+/// generator (`generate::lobe_product::encode`, once per process each: 0.03 s, 0.2 s and
+/// 1.3 s on the 2-core dev machine) and the committed one. The report section
+/// `lobe-product` measures each one's integral error against the exact product.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
+pub enum TableSize {
+    /// 12 × 12 × 16 (5.0 KB).
+    E12,
+    /// 24 × 24 × 32 (38 KB).
+    E24,
+    /// 40 × 40 × 64 (210 KB).
+    E40,
+    /// The committed 64 × 64 × 128 table (1.06 MB).
+    BuiltIn,
+}
+
+impl std::fmt::Display for TableSize {
+    /// `12×12×16`.
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let (e, a) = self.dims();
+        write!(f, "{e}×{e}×{a}")
+    }
+}
+
+impl TableSize {
+    /// Every size, coarsest first.
+    pub const ALL: [TableSize; 4] = [
+        TableSize::E12,
+        TableSize::E24,
+        TableSize::E40,
+        TableSize::BuiltIn,
+    ];
+
+    /// `(exponent samples, angle samples)`.
+    pub fn dims(self) -> (usize, usize) {
+        use steradian_core::lobe::product::{TABLE_ANGLES, TABLE_EXPONENTS};
+        match self {
+            TableSize::E12 => (12, 16),
+            TableSize::E24 => (24, 32),
+            TableSize::E40 => (40, 64),
+            TableSize::BuiltIn => (TABLE_EXPONENTS, TABLE_ANGLES),
+        }
+    }
+
+    /// Its name in plans and reports with its origin and size, e.g.
+    /// `12×12×16 (generated, 4992 bytes)`.
+    pub fn describe(self) -> String {
+        let (e, a) = self.dims();
+        let bytes = self.table().bytes();
+        match self {
+            TableSize::BuiltIn => format!("{e}×{e}×{a} (built in, {bytes} bytes)"),
+            _ => format!("{e}×{e}×{a} (generated, {bytes} bytes)"),
+        }
+    }
+
+    /// The table: the committed one, or generated on first use in this process (the bytes
+    /// and the parsed view kept for the process's life, so every product reads it without
+    /// a lock).
+    pub fn table(self) -> &'static ProductTable<'static> {
+        use std::sync::OnceLock;
+        static BUILT_IN: OnceLock<ProductTable<'static>> = OnceLock::new();
+        static BYTES: [OnceLock<Vec<u8>>; 3] = [OnceLock::new(), OnceLock::new(), OnceLock::new()];
+        static TABLES: [OnceLock<ProductTable<'static>>; 3] =
+            [OnceLock::new(), OnceLock::new(), OnceLock::new()];
+        let k = match self {
+            TableSize::BuiltIn => return BUILT_IN.get_or_init(ProductTable::builtin),
+            TableSize::E12 => 0,
+            TableSize::E24 => 1,
+            TableSize::E40 => 2,
+        };
+        TABLES[k].get_or_init(|| {
+            let (e, a) = self.dims();
+            let bytes = BYTES[k].get_or_init(|| crate::generate::lobe_product::encode(e, a));
+            ProductTable::from_bytes(bytes).expect("the generator writes valid tables")
+        })
+    }
 }
 
 impl Default for Options {
@@ -97,6 +179,7 @@ impl Default for Options {
                 leaves: Leaves::Centre,
             },
             exact_diffuse: true,
+            table: TableSize::BuiltIn,
         }
     }
 }
@@ -126,16 +209,24 @@ pub fn shade(scene: &Scene, p: &ShadingPoint, o: &Options, counts: &mut ProductC
     out
 }
 
-/// The light's cap as one lobe (`o.fit`) times the cosine about `normal`.
+/// The light's cap as one lobe (`o.fit`) times the cosine about `normal`: core's
+/// `light_with_cosine` (`Cosine::WithLight`) of the one-lobe light, with `o.table`'s
+/// product, counted the same.
 fn light_lobe(
     cap: &SphericalCap,
     normal: Vec3,
     o: &Options,
     counts: &mut ProductCounts,
 ) -> LobeSum<1> {
-    let mut l = LobeSum::<1>::new();
-    l.push_cap(cap, 1.0, o.fit);
-    light_with_cosine(&l, normal, Cosine::WithLight, counts)
+    let table = o.table.table();
+    let kernel =
+        |a: &CosineLobe, b: &CosineLobe| product_with(table, ProductFit::ExactIntegral, a, b);
+    let cos = CosineLobe::saturating(normal, 1.0, 1.0);
+    counts.computed += 1;
+    LobeSum::<1>::from_lobes(
+        0.0,
+        &[lobe_product_with(&kernel, &cap.lobe(1.0, o.fit), &cos)],
+    )
 }
 
 /// [`shade`] of up to eight points at once (`out[k]` for `points[k]`), the product of each
@@ -155,13 +246,12 @@ pub fn shade_x8(
     counts: &mut ProductCounts,
     out: &mut [Rgb],
 ) {
-    use steradian_core::lobe::product::{ProductFit, ProductTable};
     use steradian_simd::batch::LobeX8;
     use steradian_simd::lobe::product::product_x8;
     assert!(points.len() == out.len() && points.len() <= 8);
     let rxs: Vec<Receiver> = points.iter().map(|p| Receiver::of(scene, p)).collect();
     out.fill([0.0; 3]);
-    let table = ProductTable::builtin();
+    let table = o.table.table();
     for li in 0..scene.lights.len() {
         // Per lane (fixed arrays: no allocation but the occluder lists that are not empty).
         let n = points.len();
@@ -200,7 +290,7 @@ pub fn shade_x8(
                 LobeX8::from_slice(&units[..n]),
                 LobeX8::from_slice(&cosines[..n]),
             );
-            let q = product_x8(&table, ProductFit::ExactIntegral, &a, &b).to_array();
+            let q = product_x8(table, ProductFit::ExactIntegral, &a, &b).to_array();
             core::array::from_fn::<_, 8, _>(|k| {
                 CosineLobe::saturating(
                     q[k].axis(),
@@ -413,6 +503,9 @@ fn shade_light(
         }
     }
     let unoccluded = LobeSum::<1>::unoccluded();
+    let table = o.table.table();
+    let kernel =
+        |a: &CosineLobe, b: &CosineLobe| product_with(table, ProductFit::ExactIntegral, a, b);
     // The light's lobe times the cosine where it was not formed ahead, by the first chain.
     let mut own = None;
     // A chain's unshadowed and shadowed values.
@@ -421,11 +514,11 @@ fn shade_light(
             Some(l) => l,
             None => &*own.get_or_insert_with(|| light_lobe(cap, rx.normal, o, counts)),
         };
-        let u = triple(r, l, &unoccluded, 0.0, counts);
+        let u = triple_with(&kernel, r, l, &unoccluded, 0.0, counts);
         if vis.lobes.is_empty() {
             return (u as f64, u as f64);
         }
-        let v = triple(r, l, &vis, o.threshold * u.abs(), counts);
+        let v = triple_with(&kernel, r, l, &vis, o.threshold * u.abs(), counts);
         (u as f64, v as f64)
     };
     let diffuse = LobeSum::with_constant(1.0 / std::f32::consts::PI);
@@ -505,6 +598,50 @@ pub fn choose_depth(scene: &Scene, o: &Options, target: f64) -> DepthChoice {
     let (depth, estimates) =
         super::plan_choice(&depths, &images, target).unwrap_or((mask::MAX_DEPTH, Vec::new()));
     DepthChoice { depth, estimates }
+}
+
+/// The product table the plan chose, with the estimates of the sizes it tried.
+pub struct TableChoice {
+    /// The chosen size.
+    pub size: TableSize,
+    /// `(size, estimate)` per size tried against the built-in table
+    /// ([`super::probe_estimates`]).
+    pub estimates: Vec<(TableSize, f64)>,
+}
+
+/// The coarsest product table of [`TableSize::ALL`] whose probe pixels
+/// ([`super::probe_points`], shaded by [`shade`] with `o`) stay within
+/// [`super::PLAN_SHARE`] of `target` of the built-in table's. The sizes are tried coarsest
+/// first and the search stops at the first that passes, so a size is generated only when
+/// it is tried (the built-in table's probes are shaded first, as the reference).
+pub fn choose_table(scene: &Scene, o: &Options, target: f64) -> TableChoice {
+    let probes = super::probe_points(scene);
+    let mut counts = ProductCounts::default();
+    let mut shaded = |table: TableSize| -> Vec<Rgb> {
+        let ot = Options { table, ..*o };
+        probes
+            .iter()
+            .map(|p| shade(scene, p, &ot, &mut counts))
+            .collect()
+    };
+    let reference = shaded(TableSize::BuiltIn);
+    let mut estimates = Vec::new();
+    for size in TableSize::ALL {
+        if size == TableSize::BuiltIn {
+            break;
+        }
+        let img = shaded(size);
+        let e = super::probe_estimates(&[img, reference.clone()])[0];
+        estimates.push((size, e));
+        if e <= super::PLAN_SHARE * target {
+            return TableChoice { size, estimates };
+        }
+    }
+    estimates.push((TableSize::BuiltIn, 0.0));
+    TableChoice {
+        size: TableSize::BuiltIn,
+        estimates,
+    }
 }
 
 /// One pixel-centre sample per pixel ([`super::render_centres`]), surfaces shaded by

@@ -346,10 +346,24 @@ pub fn plan(scene: &Scene, o: &Options) -> Result<Plan, String> {
                          `cluster` (the scene tests assert it)"
                     .into(),
             });
+            // The table before the depth: the depth's probes read the chosen table.
+            let table = lobes::choose_table(scene, &lo, o.target_error);
+            lo.table = table.size;
             p.push(PlanItem {
                 item: "product_table".into(),
-                value: json!("built-in 64 exponents × 128 angles"),
-                reason: "the committed lobe-product table covers exponents 0–1e5".into(),
+                value: json!(lo.table.describe()),
+                reason: format!(
+                    "every lobe product reads it (each covers exponents 0–1e5): the coarsest \
+                     of {} (tried in that order, each generated on first use) that keeps {} \
+                     probe pixels, at the deepest mask, within {} of the target {} of the \
+                     built-in table's ({}); the report section lobe-product gives each \
+                     table's error against the exact product integral",
+                    lobes::TableSize::ALL.map(|t| t.to_string()).join(", "),
+                    super::PROBES.0 * super::PROBES.1,
+                    super::PLAN_SHARE,
+                    o.target_error,
+                    estimates_text("", &table.estimates)
+                ),
             });
             let choice = lobes::choose_depth(scene, &lo, o.target_error);
             if let lobes::Visibility::Mask { leaves, .. } = lo.visibility {
