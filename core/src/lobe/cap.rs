@@ -331,8 +331,10 @@ impl SphericalCap {
     /// cap `i` spans azimuths `±φᵢ` about its axis (`cos φ₁ = (cos r₂ − cos d cos r₁)/(sin d
     /// sin r₁)`, the spherical law of cosines in the triangle of the two axes and a corner)
     /// and gives `φᵢ sin²rᵢ·aᵢ − sin rᵢ cos rᵢ sin φᵢ·uᵢ`, `uᵢ` the unit tangent at `aᵢ`
-    /// toward the other axis (a whole circle, `φ = π`, gives `π sin²r·a`). Evaluated in
-    /// `f64`.
+    /// toward the other axis (a whole circle, `φ = π`, gives `π sin²r·a`). Caps on exactly
+    /// opposite axes (`d = π`, which only caps wider than a hemisphere can cross) have no
+    /// such tangent: both arcs are whole circles and the overlap is the polar band
+    /// `π(sin²r₁ − sin²r₂)·a₁`. Evaluated in `f64`.
     ///
     /// **Error bound:** within `3e-4·π·max(sin²r₁, sin²r₂)` per component of a `600 × 1200`
     /// midpoint quadrature, the quadrature's own resolution (test
@@ -372,6 +374,11 @@ impl SphericalCap {
                 let cos_phi = ((k - k_other + kd * c) / (sd * s)).clamp(-1.0, 1.0);
                 let sin_phi = math::sqrt64((1.0 - cos_phi) * (1.0 + cos_phi));
                 let phi = math::atan2_64(sin_phi, cos_phi);
+                // A whole circle (`sin φ = 0`) has no tangent term; its `u` may not exist
+                // (opposite axes: `sd = 0`).
+                if sin_phi == 0.0 {
+                    return phi * s * s * a;
+                }
                 let u = (b - cd * a) / sd;
                 phi * s * s * a - s * c * sin_phi * u
             };
@@ -667,6 +674,29 @@ mod tests {
     /// beyond; an overlap's moment is finite, no longer than the smaller cap's
     /// (`π sin²r` for caps up to a hemisphere), symmetric, and its cosine-weighted part
     /// above a normal that sees the whole first cap is at most that cap's clipped cosine.
+    /// Hard case: caps on exactly opposite axes that overlap (their half-angles sum past
+    /// `π`): the overlap is the band between them, `π(sin²r₁ − sin²r₂)·a₁`, and the
+    /// tangent of the general arcs does not exist (it gave NaN, found by the fuzz target
+    /// `cap_integrals`).
+    #[test]
+    fn overlap_moment_of_caps_on_opposite_axes() {
+        for (r1, r2) in [(3.0f32, 0.5f32), (2.0, 2.0), (1.6, 1.6), (3.1, 0.05)] {
+            let a = SphericalCap::new(Vec3::Z, r1).unwrap();
+            let b = SphericalCap::new(-Vec3::Z, r2).unwrap();
+            let want = f64::from(r1).sin().powi(2) - f64::from(r2).sin().powi(2);
+            let want = core::f64::consts::PI * want;
+            // The same vector both ways (`π(sin²r₂ − sin²r₁)·(−a₁)` from `b`).
+            for m in [a.overlap_moment(&b), b.overlap_moment(&a)] {
+                assert!(m.is_finite(), "{r1} {r2}: {m}");
+                assert!(m.x.abs() < 1e-6 && m.y.abs() < 1e-6, "{r1} {r2}: {m}");
+                assert!(
+                    (f64::from(m.z) - want).abs() < 1e-6,
+                    "{r1} {r2}: {m} vs {want}"
+                );
+            }
+        }
+    }
+
     #[test]
     fn clipped_cosine_and_overlap_moment_on_random_caps() {
         let mut state = 0x9e37_79b9_7f4a_7c15u64;
