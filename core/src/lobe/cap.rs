@@ -328,21 +328,25 @@ impl SphericalCap {
     /// With `r₁, r₂` the half-angles and `d` the angle between the axes: disjoint caps
     /// (`d ≥ r₁ + r₂`) give 0 and a cap inside the other its own moment `π sin²r·a`.
     /// Otherwise Stokes' `½∮ω × dω` runs over the overlap's two boundary arcs: the arc of
-    /// cap `i` spans azimuths `±φᵢ` about its axis (`cos φ₁ = (cos r₂ − cos d cos r₁)/(sin d
-    /// sin r₁)`, the spherical law of cosines in the triangle of the two axes and a corner)
-    /// and gives `φᵢ sin²rᵢ·aᵢ − sin rᵢ cos rᵢ sin φᵢ·uᵢ`, `uᵢ` the unit tangent at `aᵢ`
-    /// toward the other axis (a whole circle, `φ = π`, gives `π sin²r·a`). Caps on exactly
-    /// opposite axes (`d = π`, which only caps wider than a hemisphere can cross) have no
-    /// such tangent: both arcs are whole circles and the overlap is the polar band
-    /// `π(sin²r₁ − sin²r₂)·a₁`. Evaluated in `f64`.
+    /// cap `i` spans azimuths `±φᵢ` about its axis (`φᵢ` the angle at `aᵢ` of the
+    /// triangle of the two axes and a corner, with sides `rᵢ`, `d` and opposite side `rⱼ`:
+    /// `cos φ₁ = (cos r₂ − cos d cos r₁)/(sin d sin r₁)`, evaluated by the equivalent
+    /// half-angle formula, stable for small `φ`) and gives
+    /// `φᵢ sin²rᵢ·aᵢ − sin rᵢ cos rᵢ sin φᵢ·uᵢ`, `uᵢ` the unit tangent at `aᵢ` toward the
+    /// other axis (a whole circle, `φ = π`, gives `π sin²r·a`). Where `d + r₁ + r₂ ≥ 2π`
+    /// the circles do not meet (caps wider than a hemisphere that cover the sphere
+    /// together, e.g. on opposite axes): the overlap is the band between them,
+    /// `π(sin²r₁·a₁ + sin²r₂·a₂)`. Evaluated in `f64`.
     ///
     /// **Error bound:** within `3e-4·π·max(sin²r₁, sin²r₂)` per component of a `600 × 1200`
     /// midpoint quadrature, the quadrature's own resolution (test
     /// `overlap_moment_matches_quadrature`: caps of 1e-3 to 2 rad, disjoint, crossing and
     /// nested both ways), symmetric in the two caps within `1e-6` of that scale, and within
     /// `1e-6` relative of the closed forms of nested, identical and disjoint caps (test
-    /// `overlap_moment_exact_cases`). The inputs' `1 − cos` are formed from chords, so tiny
-    /// caps keep their precision.
+    /// `overlap_moment_exact_cases`). The axes' `1 − cos d` is formed from their chord and
+    /// the corner angles from differences of angles, so tiny caps keep their precision (a
+    /// cap of 1e-7 rad on a hemisphere's boundary is within 1e-6 of its own moment's scale:
+    /// test `overlap_moment_of_a_tiny_cap_on_a_boundary`).
     pub fn overlap_moment(&self, other: &SphericalCap) -> Vec3 {
         use glam::DVec3;
         let unit = |v: Vec3| {
@@ -351,12 +355,8 @@ impl SphericalCap {
         };
         let (a1, a2) = (unit(self.axis), unit(other.axis));
         let (r1, r2) = (f64::from(self.half_angle), f64::from(other.half_angle));
-        let (k1, k2) = (
-            f64::from(self.one_minus_cos),
-            f64::from(other.one_minus_cos),
-        );
-        let sc = |omc: f64| (math::sqrt64(omc * (2.0 - omc)), 1.0 - omc);
-        let ((s1, c1), (s2, c2)) = (sc(k1), sc(k2));
+        let (s1, c1) = (math::sin64(r1), math::cos64(r1));
+        let (s2, c2) = (math::sin64(r2), math::cos64(r2));
         // `1 − cos d` from the chord, so that small angles keep their precision.
         let kd = 0.5 * (a1 - a2).length_squared();
         let (cd, sd) = (1.0 - kd, a1.cross(a2).length());
@@ -368,21 +368,28 @@ impl SphericalCap {
             pi * s2 * s2 * a2
         } else if d + r1 <= r2 {
             pi * s1 * s1 * a1
+        } else if d + r1 + r2 >= 2.0 * pi {
+            // The circles do not meet (each lies in the other cap): the caps cover the
+            // sphere and overlap in a band, `∫_1 + ∫_2 − ∫_sphere` (two whole circles).
+            pi * (s1 * s1 * a1 + s2 * s2 * a2)
         } else {
-            // `cos r' − cos d·cos r` as `(1 − cos r) − (1 − cos r') + (1 − cos d)·cos r`.
-            let arc = |a: DVec3, b: DVec3, s: f64, c: f64, k: f64, k_other: f64| -> DVec3 {
-                let cos_phi = ((k - k_other + kd * c) / (sd * s)).clamp(-1.0, 1.0);
-                let sin_phi = math::sqrt64((1.0 - cos_phi) * (1.0 + cos_phi));
-                let phi = math::atan2_64(sin_phi, cos_phi);
-                // A whole circle (`sin φ = 0`) has no tangent term; its `u` may not exist
-                // (opposite axes: `sd = 0`).
-                if sin_phi == 0.0 {
-                    return phi * s * s * a;
-                }
-                let u = (b - cd * a) / sd;
-                phi * s * s * a - s * c * sin_phi * u
+            // `φᵢ` by the half-angle formula of the triangle (`aᵢ`, `aⱼ`, a corner):
+            // `tan(φᵢ/2) = √(sin(σ − rᵢ) sin(σ − d) / (sin σ sin(σ − rⱼ)))`, `σ` the
+            // half-perimeter; every factor is positive here and formed from differences
+            // of angles, so a small `φ` (a tiny cap on a large one's boundary) keeps its
+            // relative precision, which `acos` of the law of cosines loses.
+            let sigma = 0.5 * (r1 + r2 + d);
+            let sin = |x: f64| math::sin64(x).max(0.0);
+            let phi = |ri: f64, rj: f64| {
+                let y = math::sqrt64(sin(sigma - ri) * sin(sigma - d));
+                let x = math::sqrt64(sin(sigma) * sin(sigma - rj));
+                2.0 * math::atan2_64(y, x)
             };
-            arc(a1, a2, s1, c1, k1, k2) + arc(a2, a1, s2, c2, k2, k1)
+            let arc = |a: DVec3, b: DVec3, s: f64, c: f64, phi: f64| -> DVec3 {
+                let u = (b - cd * a) / sd;
+                phi * s * s * a - s * c * math::sin64(phi) * u
+            };
+            arc(a1, a2, s1, c1, phi(r1, r2)) + arc(a2, a1, s2, c2, phi(r2, r1))
         };
         if m.is_finite() {
             m.as_vec3()
@@ -669,14 +676,9 @@ mod tests {
         );
     }
 
-    /// Random caps (1e-4 rad to a whole sphere) and directions: the clipped cosine is
-    /// finite, within `[0, π·min(1, sin²α)]` for caps up to a hemisphere and `[0, π]`
-    /// beyond; an overlap's moment is finite, no longer than the smaller cap's
-    /// (`π sin²r` for caps up to a hemisphere), symmetric, and its cosine-weighted part
-    /// above a normal that sees the whole first cap is at most that cap's clipped cosine.
     /// Hard case: caps on exactly opposite axes that overlap (their half-angles sum past
-    /// `π`): the overlap is the band between them, `π(sin²r₁ − sin²r₂)·a₁`, and the
-    /// tangent of the general arcs does not exist (it gave NaN, found by the fuzz target
+    /// `π`): the overlap is the band between them, `π(sin²r₁ − sin²r₂)·a₁`, where the
+    /// general arcs have no tangent (they gave NaN; found by the fuzz target
     /// `cap_integrals`).
     #[test]
     fn overlap_moment_of_caps_on_opposite_axes() {
@@ -697,6 +699,39 @@ mod tests {
         }
     }
 
+    /// Hard case: a cap of 1e-7 rad centred on the boundary of a hemisphere (and of the
+    /// hemisphere rounded to `f32`, 4.4e-8 rad wider), half inside it: the overlap is
+    /// half the small cap, its moment `π sin²r/2` along the small cap's axis to first
+    /// order, within 1e-6 of that scale (the arc of the large cap inside the small one
+    /// spans `φ ≈ 1e-7`, whose `acos` from the law of cosines was off by about 1 %,
+    /// 1600× the small cap's moment; found by the fuzz target `cap_integrals`).
+    #[test]
+    fn overlap_moment_of_a_tiny_cap_on_a_boundary() {
+        let r = 1e-7f32;
+        for big in [FRAC_PI_2, 1.0, 0.3] {
+            let a = SphericalCap::new(Vec3::X, big).unwrap();
+            // The small cap's axis on the large cap's circle, in the xz-plane.
+            let b_axis = Vec3::new(big.cos(), 0.0, big.sin());
+            let b = SphericalCap::new(b_axis, r).unwrap();
+            let scale = core::f32::consts::PI * r * r;
+            let want = b.axis() * (0.5 * scale);
+            for m in [a.overlap_moment(&b), b.overlap_moment(&a)] {
+                // Half the cap within the f32 rounding of the axis (a few 1e-8 rad of a
+                // 1e-7 rad cap) and the hemisphere's rounding.
+                assert!(
+                    (m - want).length() <= 0.5 * scale,
+                    "{big}: {m} vs {want} (scale {scale})"
+                );
+                assert!(m.length() <= scale * (1.0 + 1e-6), "{big}: {m}");
+            }
+        }
+    }
+
+    /// Random caps (1e-4 rad to a whole sphere) and directions: the clipped cosine is
+    /// finite, within `[0, π·min(1, sin²α)]` for caps up to a hemisphere and `[0, π]`
+    /// beyond; an overlap's moment is finite, no longer than the smaller cap's
+    /// (`π sin²r` for caps up to a hemisphere), symmetric, and its cosine-weighted part
+    /// above a normal that sees the whole first cap is at most that cap's clipped cosine.
     #[test]
     fn clipped_cosine_and_overlap_moment_on_random_caps() {
         let mut state = 0x9e37_79b9_7f4a_7c15u64;
