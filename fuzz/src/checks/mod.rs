@@ -3,6 +3,7 @@
 //! `cargo test --workspace`) runs them on every input of the committed corpora
 //! (`fuzz/corpus/<target>/`).
 
+pub mod cap_integrals;
 pub mod cp;
 pub mod eval_lines;
 pub mod lobe_product;
@@ -18,7 +19,8 @@ pub mod vdt;
 pub type Check = fn(&[u8]);
 
 /// Every target, by name (the corpus folder).
-pub const TARGETS: [(&str, Check); 10] = [
+pub const TARGETS: [(&str, Check); 11] = [
+    ("cap_integrals", cap_integrals::check),
     ("cp", cp::check),
     ("eval_lines", eval_lines::check),
     ("lobe_product", lobe_product::check),
