@@ -699,6 +699,34 @@ mod tests {
         }
     }
 
+    /// Hard case: axes nearly opposite, where two wide caps stop crossing and start to
+    /// cover the sphere together (`d + r₁ + r₂ = 2π`: the corners merge, `σ → π` in the
+    /// half-angle formula): the arcs' moment meets the band's on both sides of the switch.
+    #[test]
+    fn overlap_moment_is_continuous_where_wide_caps_stop_crossing() {
+        for (r1, r2) in [(1.6f64, 1.6f64), (2.0, 1.3), (2.9, 0.5)] {
+            let switch = 2.0 * core::f64::consts::PI - r1 - r2;
+            let at = |d: f64| {
+                let a = SphericalCap::new(Vec3::Z, r1 as f32).unwrap();
+                let axis = Vec3::new(d.sin() as f32, 0.0, d.cos() as f32);
+                let b = SphericalCap::new(axis, r2 as f32).unwrap();
+                a.overlap_moment(&b)
+            };
+            // Steps of 2e-4 rad in `d` across the switch: the moment turns with the axis
+            // at a steady rate (measured 1.4e-4 to 6.3e-4 per step), so every step changes
+            // it by the same amount within 20 %, with no jump at the switch.
+            let ms: [Vec3; 9] = core::array::from_fn(|k| at(switch + (k as f64 - 4.0) * 2e-4));
+            assert!(ms.iter().all(|m| m.is_finite()), "{r1} {r2}: {ms:?}");
+            let steps: [f32; 8] = core::array::from_fn(|k| (ms[k + 1] - ms[k]).length());
+            for w in steps.windows(2) {
+                assert!(
+                    w[1] <= 1.2 * w[0] && w[0] <= 1.2 * w[1] && w[1] < 1e-3,
+                    "{r1} {r2}: {steps:?}"
+                );
+            }
+        }
+    }
+
     /// Hard case: a cap of 1e-7 rad centred on the boundary of a hemisphere (and of the
     /// hemisphere rounded to `f32`, 4.4e-8 rad wider), half inside it: the overlap is
     /// half the small cap, its moment `π sin²r/2` along the small cap's axis to first
