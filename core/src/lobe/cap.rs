@@ -727,12 +727,16 @@ mod tests {
         }
     }
 
-    /// Hard case: a cap of 1e-7 rad centred on the boundary of a hemisphere (and of the
-    /// hemisphere rounded to `f32`, 4.4e-8 rad wider), half inside it: the overlap is
-    /// half the small cap, its moment `π sin²r/2` along the small cap's axis to first
-    /// order, within 1e-6 of that scale (the arc of the large cap inside the small one
-    /// spans `φ ≈ 1e-7`, whose `acos` from the law of cosines was off by about 1 %,
-    /// 1600× the small cap's moment; found by the fuzz target `cap_integrals`).
+    /// Hard case: a cap of 1e-7 rad centred on the boundary of a hemisphere (of the `f32`
+    /// hemisphere, 4.4e-8 rad wider than π/2) and of caps of 1 and 0.3 rad. At that size
+    /// the overlap is a flat circular segment: with `δ = d − r₁` the small cap's centre
+    /// beyond the large one's circle (from the `f32` axes, in `f64`), its area is
+    /// `r²·acos(δ/r) − δ·√(r² − δ²)` and its moment that area along the small cap's axis
+    /// (the curvature of the large circle and the tilt across the segment change it by
+    /// about `r` relative). Within 1e-6 of the small cap's moment `π r²` (measured 3.3e-8).
+    /// The law of cosines' `acos` of a cosine within 1e-14 of 1 lost the 1e-7 rad arc angle's
+    /// precision there, and the moment came out far beyond the cap's own (found by the fuzz
+    /// target `cap_integrals`).
     #[test]
     fn overlap_moment_of_a_tiny_cap_on_a_boundary() {
         let r = 1e-7f32;
@@ -741,16 +745,16 @@ mod tests {
             // The small cap's axis on the large cap's circle, in the xz-plane.
             let b_axis = Vec3::new(big.cos(), 0.0, big.sin());
             let b = SphericalCap::new(b_axis, r).unwrap();
-            let scale = core::f32::consts::PI * r * r;
-            let want = b.axis() * (0.5 * scale);
+            let (a1, a2) = (a.axis().as_dvec3(), b.axis().as_dvec3());
+            let d = a1.cross(a2).length().atan2(a1.dot(a2));
+            let (rr, delta) = (f64::from(r), d - f64::from(big));
+            let x = (delta / rr).clamp(-1.0, 1.0);
+            let area = rr * rr * (x.acos() - x * (1.0 - x * x).sqrt());
+            let want = a2 * area;
+            let scale = core::f64::consts::PI * rr * rr;
             for m in [a.overlap_moment(&b), b.overlap_moment(&a)] {
-                // Half the cap within the f32 rounding of the axis (a few 1e-8 rad of a
-                // 1e-7 rad cap) and the hemisphere's rounding.
-                assert!(
-                    (m - want).length() <= 0.5 * scale,
-                    "{big}: {m} vs {want} (scale {scale})"
-                );
-                assert!(m.length() <= scale * (1.0 + 1e-6), "{big}: {m}");
+                let err = (m.as_dvec3() - want).length() / scale;
+                assert!(err <= 1e-6, "{big}: {m} vs {want}: {err:e} of {scale:e}");
             }
         }
     }
