@@ -238,9 +238,24 @@ impl<const N: usize> LobeSum<N> {
         normal: Vec3,
         counts: &mut ProductCounts,
     ) -> bool {
+        self.push_times_cosine_with(&product::product, lobe, normal, counts)
+    }
+
+    /// [`LobeSum::push_times_cosine`] with another two-lobe kernel (e.g. a
+    /// [`product::product_with`] on another table).
+    pub fn push_times_cosine_with<K>(
+        &mut self,
+        kernel: &K,
+        lobe: &CosineLobe,
+        normal: Vec3,
+        counts: &mut ProductCounts,
+    ) -> bool
+    where
+        K: Fn(&CosineLobe, &CosineLobe) -> CosineLobe,
+    {
         let cos = CosineLobe::saturating(normal, 1.0, 1.0);
         counts.computed += 1;
-        let ok = self.try_push(lobe_product(lobe, &cos));
+        let ok = self.try_push(lobe_product_with(kernel, lobe, &cos));
         counts.overflowed += u64::from(!ok);
         ok
     }
@@ -629,12 +644,27 @@ pub fn light_with_cosine<const N: usize>(
     cosine: Cosine,
     counts: &mut ProductCounts,
 ) -> LobeSum<N> {
+    light_with_cosine_with(&product::product, light, n, cosine, counts)
+}
+
+/// [`light_with_cosine`] with another two-lobe kernel (e.g. a [`product::product_with`] on
+/// another table).
+pub fn light_with_cosine_with<K, const N: usize>(
+    kernel: &K,
+    light: &LobeSum<N>,
+    n: Vec3,
+    cosine: Cosine,
+    counts: &mut ProductCounts,
+) -> LobeSum<N>
+where
+    K: Fn(&CosineLobe, &CosineLobe) -> CosineLobe,
+{
     if cosine != Cosine::WithLight {
         return *light;
     }
     let mut out = LobeSum::new();
     for l in light.lobes() {
-        out.push_times_cosine(l, n, counts);
+        out.push_times_cosine_with(kernel, l, n, counts);
     }
     let k = light.constant();
     if k != 0.0 {

@@ -5,7 +5,7 @@
 //!
 //! Per shading point `x` with normal `n`, view `ωo`, and per spherical light:
 //! - the light is the cap it subtends, as one lobe ([`SphericalCap::lobe`], eq. 31–32),
-//!   multiplied by the cosine first (core's `Cosine::WithLight`); energy-preserving by default
+//!   multiplied by the cosine first ([`Cosine::WithLight`]); energy-preserving by default
 //!   (see [`Options::fit`]);
 //! - the reflectance is the material's constant diffuse term `albedo/π` and one unit lobe
 //!   per glossy lobe (modified Phong: about the mirror direction, `(n+2)/(2π)` carried in
@@ -41,7 +41,9 @@ use steradian_core::lobe::CosineLobe;
 use steradian_core::lobe::cap::{CapFit, SphericalCap};
 use steradian_core::lobe::mask::{self, Leaves};
 use steradian_core::lobe::product::{ProductFit, ProductTable, product_with};
-use steradian_core::lobe::sum::{LobeSum, LobeVec, ProductCounts, lobe_product_with, triple_with};
+use steradian_core::lobe::sum::{
+    Cosine, LobeSum, LobeVec, ProductCounts, light_with_cosine_with, triple_with,
+};
 
 use super::image::Image;
 use super::{Kind, Rgb, Scene, ShadingPoint, Shape, render_centres, render_centres_x8};
@@ -92,9 +94,9 @@ pub struct Options {
 
 /// Resolutions of the lobe-product table (`exponents × exponents × angles`, core's
 /// [`steradian_core::lobe::product`] format): three generated at run time by the harness's
-/// generator (`generate::lobe_product::encode`, once per process each: 0.03 s, 0.2 s and
-/// 1.3 s on the 2-core dev machine) and the committed one. The report section
-/// `lobe-product` measures each one's integral error against the exact product.
+/// generator (`generate::lobe_product::encode`, once per process each) and the committed
+/// one. The report section `lobe-product` measures each one's integral error against the
+/// exact product and prints its generation time.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
 pub enum TableSize {
     /// 12 × 12 × 16 (5.0 KB).
@@ -209,24 +211,21 @@ pub fn shade(scene: &Scene, p: &ShadingPoint, o: &Options, counts: &mut ProductC
     out
 }
 
-/// The light's cap as one lobe (`o.fit`) times the cosine about `normal`: core's
-/// `light_with_cosine` (`Cosine::WithLight`) of the one-lobe light, with `o.table`'s
-/// product, counted the same.
-fn light_lobe(
+/// The light's cap as one lobe (`o.fit`) times the cosine about `normal`, by `kernel` (the
+/// product on `o.table`).
+fn light_lobe<K>(
+    kernel: &K,
     cap: &SphericalCap,
     normal: Vec3,
     o: &Options,
     counts: &mut ProductCounts,
-) -> LobeSum<1> {
-    let table = o.table.table();
-    let kernel =
-        |a: &CosineLobe, b: &CosineLobe| product_with(table, ProductFit::ExactIntegral, a, b);
-    let cos = CosineLobe::saturating(normal, 1.0, 1.0);
-    counts.computed += 1;
-    LobeSum::<1>::from_lobes(
-        0.0,
-        &[lobe_product_with(&kernel, &cap.lobe(1.0, o.fit), &cos)],
-    )
+) -> LobeSum<1>
+where
+    K: Fn(&CosineLobe, &CosineLobe) -> CosineLobe,
+{
+    let mut l = LobeSum::<1>::new();
+    l.push_cap(cap, 1.0, o.fit);
+    light_with_cosine_with(kernel, &l, normal, Cosine::WithLight, counts)
 }
 
 /// [`shade`] of up to eight points at once (`out[k]` for `points[k]`), the product of each
@@ -512,7 +511,7 @@ fn shade_light(
     let mut chain = |r: &LobeSum<1>| -> (f64, f64) {
         let l = match l {
             Some(l) => l,
-            None => &*own.get_or_insert_with(|| light_lobe(cap, rx.normal, o, counts)),
+            None => &*own.get_or_insert_with(|| light_lobe(&kernel, cap, rx.normal, o, counts)),
         };
         let u = triple_with(&kernel, r, l, &unoccluded, 0.0, counts);
         if vis.lobes.is_empty() {
