@@ -1095,11 +1095,20 @@ fn lobes_plans_the_quadtree_depth_from_the_target_error() {
 /// `--target-error` plans the lobe-product table (`choose_table`): the plan takes the
 /// coarsest size whose probe estimate is within `PLAN_SHARE` of the target (the sizes
 /// before it are not), which at the default target is the 12 × 12 × 16 table on `lobes`
-/// and `cluster` (5 KB in place of the committed 1.06 MB); the whole image with it stays
-/// within that share of the built-in table's image; a tiny target takes a finer table.
+/// and `cluster` (4992 bytes in place of the committed 1 064 960); the whole image with it
+/// stays within that share of the built-in table's image (the render's measure,
+/// `metrics::compare`); a tiny target takes a finer table.
 #[test]
 fn lobes_plans_the_product_table_from_the_target_error() {
     use lobes::TableSize;
+    // Each size's payload: `e(e + 1)/2 · a` four-byte values (a packed triangle of
+    // exponent pairs times the angles).
+    for t in TableSize::ALL {
+        let (e, a) = t.dims();
+        assert_eq!(t.table().bytes(), e * (e + 1) / 2 * a * 4, "{t}");
+    }
+    assert_eq!(TableSize::E12.table().bytes(), 4992);
+    assert_eq!(TableSize::BuiltIn.table().bytes(), 1_064_960);
     let hidden = ProgressBar::hidden();
     let target = render::DEFAULT_TARGET_ERROR;
     for name in ["lobes", "cluster"] {
@@ -1120,29 +1129,20 @@ fn lobes_plans_the_product_table_from_the_target_error() {
             ..planned
         };
         let (reference, _) = lobes::render(&small.scene, &builtin, &hidden);
-        let (w, h) = (
-            small.scene.camera.width as usize,
-            small.scene.camera.height as usize,
+        let m = metrics::compare(&small.class, &img, &reference, None, 0.0).unwrap();
+        eprintln!(
+            "{name}: planned table against the built-in one: {:.2e} of max",
+            m.mean_abs_over_max
         );
-        let (mut sum, mut max) = (0.0f64, 0.0f64);
-        for j in 0..h {
-            for i in 0..w {
-                let (a, b) = (img.get(i, j), reference.get(i, j));
-                for c in 0..3 {
-                    sum += (a[c] - b[c]).abs();
-                    max = max.max(b[c]);
-                }
-            }
-        }
-        let mean = sum / (3 * w * h) as f64 / max;
-        eprintln!("{name}: planned table against the built-in one: {mean:.2e} of max");
-        assert!(mean <= scene::PLAN_SHARE * target, "{name}: {mean}");
+        assert!(
+            m.mean_abs_over_max <= scene::PLAN_SHARE * target,
+            "{name}: {m:?}"
+        );
+        // A tiny target: the 12 × 12 × 16 table's estimate (about 1.5e-5 on `lobes`) is
+        // above its share, so a finer table is taken.
+        let tight = plan_at(&small.scene, render::Method::Lobes, 1e-6).lobes;
+        assert!(tight.table > TableSize::E12, "{name}: {:?}", tight.table);
     }
-    // A tiny target: the 12 × 12 × 16 table's estimate (about 1.5e-5 on `lobes`) is above
-    // its share, so a finer table is taken.
-    let small = Small::new("lobes", 64, 16, 0);
-    let tight = plan_at(&small.scene, render::Method::Lobes, 1e-6).lobes;
-    assert!(tight.table > TableSize::E12, "{:?}", tight.table);
 }
 
 /// `--target-error` plans the `hvl` count: the probe estimates fall to 0 at the largest

@@ -43,15 +43,14 @@ use crate::scene::{Scene, Seen, hvl, lobes, path, render, rsl};
 
 /// Image width of the section's renders (the height follows each scene's aspect ratio).
 pub const WIDTH: u32 = 96;
-/// Samples per pixel of the `lobes` and `cluster` references. At 512 their noise
-/// (`reference_noise_over_max`) was half the `lobes` method's error (2.8e-4 against
-/// 5.4e-4 of max on `lobes`, 8.3e-4 against 1.55e-3 on `cluster`): a noisy reference
-/// inflates the method's error and the path tracer's alike, and the path tracer's curve,
+/// Samples per pixel of the `lobes` and `cluster` references. A noisy reference inflates
+/// the method's error and the path tracer's alike, and the path tracer's curve,
 /// extrapolated as `spp^−½` from a point that carries that noise, then reaches the method's
-/// error in too few samples.
+/// error in too few samples: at 512 the noise (`reference_noise_over_max`) was about half
+/// the `lobes` method's error on both scenes.
 pub const REFERENCE_SPP: u32 = 2048;
-/// Samples per pixel of the `room` reference (one bounce): at 512 its noise was 1.3e-3 of
-/// max against the `hvl` method's 1.38e-3, so the method's error was mostly the reference's.
+/// Samples per pixel of the `room` reference (one bounce): at 512 its noise was nearly all
+/// of the `hvl` method's measured error.
 pub const ROOM_REFERENCE_SPP: u32 = 4096;
 /// Samples per pixel of the `environment` reference: at 512 its noise
 /// (`reference_noise_over_max` in the report) was as large as the `rsl` method's error.
