@@ -1182,3 +1182,71 @@ fn hvl_plans_the_hvl_count_from_the_target_error() {
         "{m:?}"
     );
 }
+
+/// `hvl` plans the lattice its indirect light is interpolated on (`choose_stride`): the
+/// estimates end at 0 for every pixel computed and the plan takes the coarsest spacing
+/// within `PLAN_SHARE` of the target; on `room` at 64 columns the strided render equals the
+/// every-pixel one at the lattice's nodes, differs from it by at most that share over the
+/// whole image, and stays within the target against the path tracer; a tiny target
+/// computes every pixel.
+#[test]
+fn hvl_plans_the_indirect_lattice_from_the_target_error() {
+    use steradian_harness::scene::hvl;
+    let small = Small::new("room", 64, 256, 1);
+    let target = render::DEFAULT_TARGET_ERROR;
+    let planned = plan_at(&small.scene, render::Method::Hvl, target).hvl;
+    let c = hvl::choose_stride(&small.scene, &planned, target);
+    eprintln!("{c:?}");
+    assert_eq!(c.estimates.last(), Some(&(1, 0.0)));
+    let first = c
+        .estimates
+        .iter()
+        .find(|x| x.1 <= scene::PLAN_SHARE * target)
+        .map(|x| x.0);
+    assert_eq!(first, Some(c.stride));
+    // The README's figure: spacing 3 on `room` at 64 columns.
+    assert_eq!((planned.stride, c.stride), (3, 3));
+    let hidden = ProgressBar::hidden();
+    let strided = hvl::render(&small.scene, &planned, &hidden).0;
+    let every = hvl::render(
+        &small.scene,
+        &hvl::Options {
+            stride: 1,
+            ..planned
+        },
+        &hidden,
+    )
+    .0;
+    let (w, s) = (strided.width, planned.stride);
+    let (mut nodes, mut sum, mut n) = (0, 0.0, 0);
+    let mut max: f64 = 0.0;
+    for (k, (a, b)) in strided.data.iter().zip(&every.data).enumerate() {
+        if small.class[k] != Some(true) {
+            continue;
+        }
+        let (i, j) = (k % w, k / w);
+        if i % s == 0 && j % s == 0 {
+            assert_eq!(a, b, "node ({i}, {j})");
+            nodes += 1;
+        }
+        sum += (0..3).map(|c| (a[c] - b[c]).abs()).sum::<f64>() / 3.0;
+        n += 1;
+        max = max.max(b.iter().cloned().fold(0.0, f64::max));
+    }
+    let gap = sum / n as f64 / max;
+    eprintln!("stride {s}: {nodes} nodes, mean |strided − every pixel| = {gap:.2e} of max");
+    assert!(nodes > 100 && gap > 0.0, "{nodes} {gap}");
+    assert!(gap <= scene::PLAN_SHARE * target, "{gap:e}");
+    let m = small.errors(&strided);
+    let m1 = small.errors(&every);
+    eprintln!("strided {m:?}\nevery pixel {m1:?}");
+    assert!(
+        m.mean_abs_over_max <= m1.mean_abs_over_max + scene::PLAN_SHARE * target,
+        "{m:?}"
+    );
+    assert!(
+        m.mean_abs_over_max < target + 4.0 * m.reference_noise_over_max,
+        "{m:?}"
+    );
+    assert_eq!(hvl::choose_stride(&small.scene, &planned, 1e-7).stride, 1);
+}

@@ -339,6 +339,20 @@ pub fn render_centres_x8<S: Send>(
     new_state: impl Fn() -> S + Sync,
     shade: impl Fn(&mut S, &[ShadingPoint], &mut [Rgb]) + Sync,
 ) -> (Image, Vec<S>) {
+    render_centres_x8_at(scene, bar, new_state, |state, _, ps, out| {
+        shade(state, ps, out)
+    })
+}
+
+/// [`render_centres_x8`] that also tells `shade` where its points are:
+/// `shade(state, pixels, points, out)` with `pixels[k] = (i, j)`, the column and row of
+/// `points[k]`.
+pub fn render_centres_x8_at<S: Send>(
+    scene: &Scene,
+    bar: &ProgressBar,
+    new_state: impl Fn() -> S + Sync,
+    shade: impl Fn(&mut S, &[(usize, usize)], &[ShadingPoint], &mut [Rgb]) + Sync,
+) -> (Image, Vec<S>) {
     let cam = scene.camera;
     let (w, h) = (cam.width as usize, cam.height as usize);
     let rows: Vec<(Vec<Rgb>, S)> = (0..h)
@@ -352,7 +366,7 @@ pub fn render_centres_x8<S: Send>(
                 match scene.see(&cam.centre_ray(i as u32, j as u32)) {
                     Seen::Radiance(l) => *px = l,
                     Seen::Surface(p) => {
-                        pixels.push(i);
+                        pixels.push((i, j));
                         points.push(p);
                     }
                 }
@@ -360,8 +374,8 @@ pub fn render_centres_x8<S: Send>(
             let mut out = [[0.0; 3]; 8];
             for (is, ps) in pixels.chunks(8).zip(points.chunks(8)) {
                 let out = &mut out[..ps.len()];
-                shade(&mut state, ps, out);
-                for (&i, v) in is.iter().zip(out.iter()) {
+                shade(&mut state, is, ps, out);
+                for (&(i, _), v) in is.iter().zip(out.iter()) {
                     row[i] = *v;
                 }
             }
@@ -392,6 +406,11 @@ pub const PROBES: (u32, u32) = (32, 24);
 /// The surface points seen through a [`PROBES`] grid of pixel centres (pixels that see a
 /// light or the environment are left out).
 pub fn probe_points(scene: &Scene) -> Vec<ShadingPoint> {
+    probe_pixels(scene).into_iter().map(|(_, _, p)| p).collect()
+}
+
+/// [`probe_points`] with their pixels: `(column, row, point)`.
+pub fn probe_pixels(scene: &Scene) -> Vec<(usize, usize, ShadingPoint)> {
     let cam = scene.camera;
     let mut out = Vec::new();
     for b in 0..PROBES.1 {
@@ -399,7 +418,7 @@ pub fn probe_points(scene: &Scene) -> Vec<ShadingPoint> {
             let i = ((2 * a + 1) * cam.width / (2 * PROBES.0)).min(cam.width - 1);
             let j = ((2 * b + 1) * cam.height / (2 * PROBES.1)).min(cam.height - 1);
             if let Seen::Surface(p) = scene.see(&cam.centre_ray(i, j)) {
-                out.push(p);
+                out.push((i as usize, j as usize, p));
             }
         }
     }

@@ -492,6 +492,36 @@ pub fn plan(scene: &Scene, o: &Options) -> Result<Plan, String> {
                     value: json!(hv.visibility),
                     reason: "a shadow ray per HVL–receiver pair (the paper tests none)".into(),
                 });
+                if o.gpu {
+                    hv.stride = 1;
+                    p.push(PlanItem {
+                        item: "indirect_stride".into(),
+                        value: json!(1),
+                        reason: "--gpu: the indirect light at every pixel (the wgpu path \
+                                 interpolates none)"
+                            .into(),
+                    });
+                } else {
+                    let stride = super::hvl::choose_stride(scene, &hv, o.target_error);
+                    hv.stride = stride.stride;
+                    p.push(PlanItem {
+                        item: "indirect_stride".into(),
+                        value: json!(hv.stride),
+                        reason: format!(
+                            "the indirect light computed every {0} pixels across and down and \
+                             interpolated between on the same object and normal (1: every \
+                             pixel, the paper): {0} is the coarsest of {1:?} that keeps {2} \
+                             probe pixels within {3} of the target {4} of every pixel \
+                             computed ({5})",
+                            hv.stride,
+                            super::hvl::STRIDE_CANDIDATES,
+                            super::PROBES.0 * super::PROBES.1,
+                            super::PLAN_SHARE,
+                            o.target_error,
+                            estimates_text("stride ", &stride.estimates)
+                        ),
+                    });
+                }
             }
         }
     }
