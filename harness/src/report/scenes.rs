@@ -19,7 +19,7 @@
 //! threshold, with the L2 cap fit and
 //! one lobe per occluder (instead of the default energy-preserving fit and quadtree mask)
 //! beside it; the `hvl` method's curve is its HVL count at the planned lattice stride
-//! (`hvl::Lattice`), with every pixel computed (the paper), the paper's choice of no HVL
+//! (`scene::lattice`), with every pixel computed (the paper), the paper's choice of no HVL
 //! visibility and the direct light alone beside it (the one-core throughputs of its
 //! kernels are measured with every pixel computed); the `rsl` method's is its number
 //! of square lights `K`. Times

@@ -32,7 +32,7 @@ use steradian_core::lobe::sum::ProductCounts;
 use steradian_core::sh::{brdf, hvl as core_hvl};
 
 use super::image::Image;
-use super::{Kind, Ray, Rgb, Scene, Seen, ShadingPoint, Shape, lobes, path, render_centres};
+use super::{Kind, Ray, Rgb, Scene, ShadingPoint, Shape, lattice, lobes, path, render_centres};
 
 /// Settings of the `hvl` method.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -55,8 +55,9 @@ pub struct Options {
     /// bit) and shade the direct light by the `lobes` method's SIMD path
     /// ([`lobes::shade_x8`]); `false` the scalar kernels, one HVL and point at a time.
     pub simd: bool,
-    /// Pixel spacing of the lattice the indirect light of diffuse receivers is computed on
-    /// ([`Lattice`]); 1 computes it at every pixel (the paper).
+    /// Pixel spacing of the lattice the indirect light is computed on and interpolated
+    /// between ([`lattice::Lattice`], planned by [`choose_stride`]); 1 computes it at every
+    /// pixel (the paper).
     pub stride: usize,
 }
 
@@ -823,135 +824,6 @@ pub fn choose_bands(scene: &Scene, o: &Options, target: f64) -> BandsChoice {
     BandsChoice { bands, estimates }
 }
 
-/// Smallest cosine between the normals of a pixel and a lattice node its indirect light is
-/// interpolated from ([`Lattice`]).
-pub const LATTICE_NORMAL_COS: f64 = 0.95;
-
-/// Least bilinear weight of a pixel's usable lattice corners ([`Lattice`]).
-pub const LATTICE_MIN_WEIGHT: f64 = 0.5;
-
-/// The lattice spacings a plan tries, coarsest first ([`choose_stride`]; 1 is every pixel).
-pub const STRIDE_CANDIDATES: [usize; 4] = [4, 3, 2, 1];
-
-/// The indirect light of a strided render: computed at the lattice of pixels `(a·s, b·s)`
-/// (the last column and row clamped to the image) and interpolated between.
-///
-/// Indirect light from hundreds of HVLs varies slowly across a surface (each HVL's share
-/// is a smooth function of the receiver's position and normal, and the glossy parts are
-/// band-limited by their SH tables), so a pixel takes the bilinear interpolation, by pixel
-/// distance, of those corners of its lattice cell that lie on its own object with a normal
-/// within [`LATTICE_NORMAL_COS`] of its own, renormalised over them, when they hold at
-/// least [`LATTICE_MIN_WEIGHT`] of its weight; any other pixel (at an object's edge or a
-/// crease) computes its own. The interpolation is exact where the indirect light is
-/// bilinear across the cell; the plan ([`choose_stride`]) measures what it costs
-/// elsewhere, and `stride = 1` (the paper) computes every pixel.
-pub struct Lattice {
-    stride: usize,
-    width: usize,
-    height: usize,
-    columns: usize,
-    nodes: Vec<Option<(ShadingPoint, Rgb)>>,
-}
-
-impl Lattice {
-    /// The lattice of spacing `o.stride` over `scene`'s image, its nodes shaded in parallel.
-    pub fn build(scene: &Scene, o: &Options, at: &Placement, glossy: &GlossyViews<'_>) -> Lattice {
-        use rayon::prelude::*;
-        let cam = scene.camera;
-        let (w, h) = (cam.width as usize, cam.height as usize);
-        let s = o.stride.max(1);
-        let (columns, rows) = ((w - 1).div_ceil(s) + 1, (h - 1).div_ceil(s) + 1);
-        let nodes = (0..columns * rows)
-            .into_par_iter()
-            .map_init(Scratch::default, |scratch, k| {
-                let (i, j) = (
-                    ((k % columns) * s).min(w - 1),
-                    ((k / columns) * s).min(h - 1),
-                );
-                node(scene, o, at, glossy, scratch, i, j)
-            })
-            .collect();
-        Lattice {
-            stride: s,
-            width: w,
-            height: h,
-            columns,
-            nodes,
-        }
-    }
-
-    /// The indirect light at pixel `(i, j)`, which sees `p`, interpolated from its cell's
-    /// corners; `None` where they do not allow it (see [`Lattice`]).
-    pub fn interpolate(&self, i: usize, j: usize, p: &ShadingPoint) -> Option<Rgb> {
-        let (s, w, h) = (self.stride, self.width, self.height);
-        interpolate_cell(s, w, h, i, j, p, |a, b| {
-            self.nodes.get(b * self.columns + a).copied().flatten()
-        })
-    }
-}
-
-/// A lattice node: the surface point pixel `(i, j)` sees and its indirect light.
-fn node(
-    scene: &Scene,
-    o: &Options,
-    at: &Placement,
-    glossy: &GlossyViews<'_>,
-    scratch: &mut Scratch,
-    i: usize,
-    j: usize,
-) -> Option<(ShadingPoint, Rgb)> {
-    match scene.see(&scene.camera.centre_ray(i as u32, j as u32)) {
-        Seen::Surface(p) => Some((p, indirect(scene, &p, at, o, glossy, scratch))),
-        Seen::Radiance(_) => None,
-    }
-}
-
-/// The rule of [`Lattice`] for pixel `(i, j)` (seeing `p`) of a `w × h` image at spacing
-/// `s`, the node at lattice column `a` and row `b` given by `node(a, b)`.
-fn interpolate_cell(
-    s: usize,
-    w: usize,
-    h: usize,
-    i: usize,
-    j: usize,
-    p: &ShadingPoint,
-    mut node: impl FnMut(usize, usize) -> Option<(ShadingPoint, Rgb)>,
-) -> Option<Rgb> {
-    let axis = |x: usize, n: usize| {
-        let a = x / s;
-        let (x0, x1) = (a * s, ((a + 1) * s).min(n - 1));
-        let f = if x1 > x0 {
-            (x - x0) as f64 / (x1 - x0) as f64
-        } else {
-            0.0
-        };
-        (a, f)
-    };
-    let (a, fx) = axis(i, w);
-    let (b, fy) = axis(j, h);
-    let mut out = [0.0; 3];
-    let mut total = 0.0;
-    for (da, wx) in [(0, 1.0 - fx), (1, fx)] {
-        for (db, wy) in [(0, 1.0 - fy), (1, fy)] {
-            let wgt = wx * wy;
-            if wgt == 0.0 {
-                continue;
-            }
-            let Some((q, v)) = node(a + da, b + db) else {
-                continue;
-            };
-            if q.object != p.object || q.n.dot(p.n) < LATTICE_NORMAL_COS {
-                continue;
-            }
-            total += wgt;
-            for k in 0..3 {
-                out[k] += wgt * v[k];
-            }
-        }
-    }
-    (total >= LATTICE_MIN_WEIGHT).then(|| out.map(|v| v / total))
-}
-
 /// What [`choose_stride`] chose and what it measured.
 #[derive(Clone, Debug)]
 pub struct StrideChoice {
@@ -962,16 +834,13 @@ pub struct StrideChoice {
     pub estimates: Vec<(usize, f64)>,
 }
 
-/// The coarsest lattice spacing of [`STRIDE_CANDIDATES`] whose interpolation keeps the
-/// probe pixels within [`super::PLAN_SHARE`] of `target` of every pixel computed (the rule
-/// of [`choose_side`]). Each probe pixel ([`super::probe_pixels`]) is shaded as a strided
-/// render shades it: its cell's corners computed, the rule of [`Lattice`] applied, and
-/// computed itself where the rule refuses; the direct light is added to every candidate
-/// alike.
+/// The coarsest lattice spacing of [`lattice::STRIDE_CANDIDATES`] whose interpolation of
+/// the indirect light keeps the probe pixels within [`super::PLAN_SHARE`] of `target` of
+/// every pixel computed (the rule of [`choose_side`]), each probe shaded as a strided
+/// render shades it ([`lattice::strided_probes`]), the direct light added to every
+/// candidate alike.
 pub fn choose_stride(scene: &Scene, o: &Options, target: f64) -> StrideChoice {
     let probes = super::probe_pixels(scene);
-    let cam = scene.camera;
-    let (w, h) = (cam.width as usize, cam.height as usize);
     let at = Placement::new(scene, place(scene, o.side));
     let glossy = if o.glossy {
         Glossy::build(scene)
@@ -981,45 +850,28 @@ pub fn choose_stride(scene: &Scene, o: &Options, target: f64) -> StrideChoice {
     let glossy = glossy.views();
     let mut scratch = Scratch::default();
     let mut counts = ProductCounts::default();
-    let shaded: Vec<(Rgb, Rgb)> = probes
+    let direct: Vec<Rgb> = probes
         .iter()
-        .map(|&(_, _, p)| {
-            let d = lobes::shade(scene, &p, &o.direct, &mut counts);
-            (d, indirect(scene, &p, &at, o, &glossy, &mut scratch))
-        })
+        .map(|(_, _, p)| lobes::shade(scene, p, &o.direct, &mut counts))
         .collect();
-    let images: Vec<Vec<Rgb>> = STRIDE_CANDIDATES
+    let own: Vec<Rgb> = probes
         .iter()
-        .map(|&s| {
-            probes
-                .iter()
-                .zip(&shaded)
-                .map(|(&(i, j, p), &(d, own))| {
-                    let ind = if s == 1 {
-                        own
-                    } else {
-                        interpolate_cell(s, w, h, i, j, &p, |a, b| {
-                            let (x, y) = ((a * s).min(w - 1), (b * s).min(h - 1));
-                            if (x, y) == (i, j) {
-                                return Some((p, own));
-                            }
-                            node(scene, o, &at, &glossy, &mut scratch, x, y)
-                        })
-                        .unwrap_or(own)
-                    };
-                    [d[0] + ind[0], d[1] + ind[1], d[2] + ind[2]]
-                })
-                .collect()
-        })
+        .map(|(_, _, p)| indirect(scene, p, &at, o, &glossy, &mut scratch))
         .collect();
+    let images = lattice::strided_probes(scene, &probes, &own, &direct, |p| {
+        indirect(scene, p, &at, o, &glossy, &mut scratch)
+    });
     let (stride, estimates) =
-        super::plan_choice(&STRIDE_CANDIDATES, &images, target).unwrap_or((1, Vec::new()));
+        super::plan_choice(&lattice::STRIDE_CANDIDATES, &images, target).unwrap_or((1, Vec::new()));
     StrideChoice { stride, estimates }
 }
 
 /// Direct light by the `lobes` method plus one bounce from HVLs, one pixel-centre sample
 /// per pixel ([`super::render_centres_x8_at`]), the indirect light interpolated on a
-/// [`Lattice`] when `o.stride > 1`; returns the image and the HVL count.
+/// [`lattice::Lattice`] of spacing `o.stride` when it is above 1 (indirect light from
+/// hundreds of HVLs varies slowly across a surface: each HVL's share is smooth in the
+/// receiver's position and normal, and the glossy parts are band-limited by their SH
+/// tables); returns the image and the HVL count.
 pub fn render(scene: &Scene, o: &Options, bar: &ProgressBar) -> (Image, usize) {
     let at = Placement::new(scene, place(scene, o.side));
     let glossy = if o.glossy {
@@ -1028,7 +880,16 @@ pub fn render(scene: &Scene, o: &Options, bar: &ProgressBar) -> (Image, usize) {
         Glossy::none(scene)
     };
     let glossy = glossy.views();
-    let lattice = (o.stride > 1).then(|| Lattice::build(scene, o, &at, &glossy));
+    let nodes = |ps: &[ShadingPoint]| -> Result<Vec<Rgb>, String> {
+        let mut scratch = Scratch::default();
+        Ok(ps
+            .iter()
+            .map(|p| indirect(scene, p, &at, o, &glossy, &mut scratch))
+            .collect())
+    };
+    let lattice = (o.stride > 1)
+        .then(|| lattice::Lattice::build(scene, o.stride, &nodes).ok())
+        .flatten();
     let new_state = || (ProductCounts::default(), Scratch::default());
     let (img, _) =
         super::render_centres_x8_at(scene, bar, new_state, |(counts, scratch), pix, ps, out| {
@@ -1098,82 +959,5 @@ mod tests {
             );
         }
         assert!(culled_walls > 1000, "{culled_walls}");
-    }
-
-    fn point(object: usize, n: DVec3) -> ShadingPoint {
-        ShadingPoint {
-            object,
-            material: 0,
-            x: DVec3::ZERO,
-            n,
-            wo: DVec3::Z,
-        }
-    }
-
-    /// The lattice rule is exact on a field bilinear in the pixel coordinates (every pixel
-    /// of a 23 × 17 image at spacings 2–5, the last column and row clamped), and takes a
-    /// corner's value at the corner itself.
-    #[test]
-    fn lattice_interpolation_is_exact_on_a_bilinear_field() {
-        let (w, h) = (23, 17);
-        let field = |x: usize, y: usize| {
-            let (x, y) = (x as f64, y as f64);
-            [
-                1.0 + 0.5 * x - 0.25 * y + 0.01 * x * y,
-                2.0 - 0.1 * x,
-                0.3 * y,
-            ]
-        };
-        let p = point(3, DVec3::Z);
-        for s in 2..=5 {
-            for j in 0..h {
-                for i in 0..w {
-                    let got = interpolate_cell(s, w, h, i, j, &p, |a, b| {
-                        let (x, y) = ((a * s).min(w - 1), (b * s).min(h - 1));
-                        Some((p, field(x, y)))
-                    })
-                    .unwrap();
-                    let want = field(i, j);
-                    for c in 0..3 {
-                        assert!(
-                            (got[c] - want[c]).abs() < 1e-12,
-                            "s {s} ({i}, {j}): {got:?} {want:?}"
-                        );
-                    }
-                }
-            }
-        }
-    }
-
-    /// Corners on another object, with a normal beyond `LATTICE_NORMAL_COS` or seeing no
-    /// surface are left out and the rest renormalised; under `LATTICE_MIN_WEIGHT` of the
-    /// weight left the pixel computes its own (`None`).
-    #[test]
-    fn lattice_interpolation_leaves_out_other_surfaces() {
-        let p = point(1, DVec3::Z);
-        let tilted = DVec3::new(0.4, 0.0, 1.0).normalize(); // cos 0.93
-        // Pixel (1, 1) of a 5 × 5 image at spacing 4: corner weights 9/16, 3/16, 3/16, 1/16.
-        let run = |bad: &[(usize, usize)], how: u8| {
-            interpolate_cell(4, 5, 5, 1, 1, &p, |a, b| {
-                let v = [(1 + a + 2 * b) as f64; 3];
-                if !bad.contains(&(a, b)) {
-                    return Some((p, v));
-                }
-                match how {
-                    0 => Some((point(2, DVec3::Z), v)),
-                    1 => Some((point(1, tilted), v)),
-                    _ => None,
-                }
-            })
-        };
-        let all = run(&[], 0).unwrap()[0];
-        assert!((all - (9.0 * 1.0 + 3.0 * 2.0 + 3.0 * 3.0 + 4.0) / 16.0).abs() < 1e-12);
-        for how in 0..3 {
-            // Without the far corner (1/16): the other three renormalised over 15/16.
-            let v = run(&[(1, 1)], how).unwrap()[0];
-            assert!((v - (9.0 + 6.0 + 9.0) / 15.0).abs() < 1e-12, "{how}: {v}");
-            // Without the near corner (9/16): 7/16 left, under the least weight.
-            assert_eq!(run(&[(0, 0)], how), None, "{how}");
-        }
     }
 }

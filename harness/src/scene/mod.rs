@@ -21,6 +21,7 @@ pub mod file;
 pub mod geom;
 pub mod hvl;
 pub mod image;
+pub mod lattice;
 pub mod light;
 pub mod lobes;
 pub mod material;

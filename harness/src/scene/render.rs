@@ -514,7 +514,7 @@ pub fn plan(scene: &Scene, o: &Options) -> Result<Plan, String> {
                              probe pixels within {3} of the target {4} of every pixel \
                              computed ({5})",
                             hv.stride,
-                            super::hvl::STRIDE_CANDIDATES,
+                            super::lattice::STRIDE_CANDIDATES,
                             super::PROBES.0 * super::PROBES.1,
                             super::PLAN_SHARE,
                             o.target_error,
