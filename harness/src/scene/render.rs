@@ -508,11 +508,18 @@ pub fn plan(scene: &Scene, o: &Options) -> Result<Plan, String> {
                         item: "indirect_stride".into(),
                         value: json!(hv.stride),
                         reason: format!(
-                            "the indirect light computed every {0} pixels across and down and \
-                             interpolated between on the same object and normal (1: every \
-                             pixel, the paper): {0} is the coarsest of {1:?} that keeps {2} \
-                             probe pixels within {3} of the target {4} of every pixel \
-                             computed ({5})",
+                            "{0}: {1} is the coarsest of {2:?} that keeps {3} probe pixels \
+                             within {4} of the target {5} of every pixel computed ({6})",
+                            if hv.stride == 1 {
+                                "the indirect light computed at every pixel (the paper)".into()
+                            } else {
+                                format!(
+                                    "the indirect light computed every {} pixels across and \
+                                     down and interpolated between on the same object and \
+                                     normal (scene::lattice)",
+                                    hv.stride
+                                )
+                            },
                             hv.stride,
                             super::lattice::STRIDE_CANDIDATES,
                             super::PROBES.0 * super::PROBES.1,
