@@ -330,6 +330,15 @@ pub struct Glossy {
 }
 
 impl Glossy {
+    /// The tables of `scene`'s materials with `o.glossy` ([`Glossy::build`]), none without.
+    pub fn of(scene: &Scene, o: &Options) -> Glossy {
+        if o.glossy {
+            Glossy::build(scene)
+        } else {
+            Glossy::none(scene)
+        }
+    }
+
     /// No glossy part anywhere (the diffuse-only receiver).
     pub fn none(scene: &Scene) -> Glossy {
         Glossy {
@@ -664,11 +673,7 @@ pub fn render_gpu(
 ) -> Result<(Image, usize), String> {
     use crate::backend::gpu::Custom;
     use crate::kernels::Columns;
-    let glossy = if o.glossy {
-        Glossy::build(scene)
-    } else {
-        Glossy::none(scene)
-    };
+    let glossy = Glossy::of(scene, o);
     let views = glossy.views();
     let at = Placement::new(scene, place(scene, o.side));
     let hvls = &at.placed;
@@ -775,11 +780,7 @@ fn probe_images<T: Copy>(
         .map(|p| lobes::shade(scene, p, &o.direct, &mut counts))
         .collect();
     let mut scratch = Scratch::default();
-    let glossy = if o.glossy {
-        Glossy::build(scene)
-    } else {
-        Glossy::none(scene)
-    };
+    let glossy = Glossy::of(scene, o);
     let glossy = glossy.views();
     candidates
         .iter()
@@ -842,11 +843,7 @@ pub struct StrideChoice {
 pub fn choose_stride(scene: &Scene, o: &Options, target: f64) -> StrideChoice {
     let probes = super::probe_pixels(scene);
     let at = Placement::new(scene, place(scene, o.side));
-    let glossy = if o.glossy {
-        Glossy::build(scene)
-    } else {
-        Glossy::none(scene)
-    };
+    let glossy = Glossy::of(scene, o);
     let glossy = glossy.views();
     let mut scratch = Scratch::default();
     let mut counts = ProductCounts::default();
@@ -874,11 +871,7 @@ pub fn choose_stride(scene: &Scene, o: &Options, target: f64) -> StrideChoice {
 /// tables); returns the image and the HVL count.
 pub fn render(scene: &Scene, o: &Options, bar: &ProgressBar) -> (Image, usize) {
     let at = Placement::new(scene, place(scene, o.side));
-    let glossy = if o.glossy {
-        Glossy::build(scene)
-    } else {
-        Glossy::none(scene)
-    };
+    let glossy = Glossy::of(scene, o);
     let glossy = glossy.views();
     let nodes = |ps: &[ShadingPoint]| -> Result<Vec<Rgb>, String> {
         let mut scratch = Scratch::default();
