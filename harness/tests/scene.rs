@@ -1187,8 +1187,8 @@ fn hvl_plans_the_hvl_count_from_the_target_error() {
 /// estimates end at 0 for every pixel computed and the plan takes the coarsest spacing
 /// within `PLAN_SHARE` of the target; on `room` at 64 columns the strided render equals the
 /// every-pixel one at the lattice's nodes, differs from it by at most that share over the
-/// whole image, and stays within the target against the path tracer; a tiny target
-/// computes every pixel.
+/// whole image, and stays within the target (and the every-pixel render's RMSE bound)
+/// against the path tracer; a tiny target computes every pixel.
 #[test]
 fn hvl_plans_the_indirect_lattice_from_the_target_error() {
     use steradian_harness::scene::hvl;
@@ -1248,5 +1248,8 @@ fn hvl_plans_the_indirect_lattice_from_the_target_error() {
         m.mean_abs_over_max < target + 4.0 * m.reference_noise_over_max,
         "{m:?}"
     );
+    // The bound `hvl_method_against_the_path_tracer_on_a_small_room` asserts for every
+    // pixel computed (the HVL paper reports 0.039 on its scene).
+    assert!(m.rmse < 0.035, "RMSE {}", m.rmse);
     assert_eq!(hvl::choose_stride(&small.scene, &planned, 1e-7).stride, 1);
 }
