@@ -662,7 +662,8 @@ fn gpu_sum_table(scene: &Scene, hvls: &[Placed], bands: usize, visibility: bool)
 /// toward an HVL on it meets the plane before its end), times the receiver's diffuse
 /// albedo. Each receiver's sum is within `steradian_core::wgsl::SH_HVL_SUM_TOL` of the
 /// CPU's wherever no shadow ray flips between `f32` and `f64` (harness test
-/// `hvl_gpu_path_matches_the_cpu_path` in `tests/scene.rs`).
+/// `hvl_gpu_path_matches_the_cpu_path` in `tests/scene.rs`). Every pixel is computed,
+/// whatever `o.stride` (the plan sets it to 1 with `--gpu`).
 ///
 /// Errors: the kernel's.
 pub fn render_gpu(
