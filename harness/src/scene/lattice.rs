@@ -48,7 +48,7 @@ pub struct Lattice {
 
 impl Lattice {
     /// The lattice of spacing `stride` (at least 1) over `scene`'s image, the surface points
-    /// its nodes see shaded by `shade`, [`CHUNK`] at a time in parallel.
+    /// its nodes see shaded by `shade`, 64 at a time in parallel.
     ///
     /// Errors: `shade`'s.
     pub fn build(scene: &Scene, stride: usize, shade: &ShadeSet<'_>) -> Result<Lattice, String> {
