@@ -609,7 +609,8 @@ fn hvl_method_against_the_path_tracer_on_a_small_room() {
 
 /// The `rsl` method (K = 30) on a small `environment` scene against the path tracer (direct
 /// light): relative L2 within the bound measured here (the RSL paper's 0.35 % is not met;
-/// the test prints the measured errors).
+/// the test prints the measured errors), most of the squared error on the glossy sphere
+/// (measured 0.91 of it) and the other pixels alone within 1 % (measured 0.65 %).
 #[test]
 fn rsl_method_against_the_path_tracer_on_a_small_environment_scene() {
     use steradian_harness::scene::rsl;
@@ -629,6 +630,36 @@ fn rsl_method_against_the_path_tracer_on_a_small_environment_scene() {
         m.mean_abs_over_max < 0.012 + 4.0 * m.reference_noise_over_max,
         "{m:?}"
     );
+    // Where the error is: the glossy sphere, which reflects the 30 uniform squares, holds
+    // most of the noise-corrected squared error; the other pixels alone are within 1 %.
+    let s = &small.scene;
+    let glossy = s.material_names.iter().position(|n| n == "glossy").unwrap();
+    let (w, r) = (s.camera.width, &small.reference);
+    // (Σ (m − r)² − Σ σ², Σ r² − Σ σ²) over the shaded pixels of the glossy sphere, then
+    // over the others.
+    let mut sums = [[0.0f64; 2]; 2];
+    for (k, c) in small.class.iter().enumerate() {
+        let scene::Seen::Surface(p) = s.see(&s.camera.centre_ray(k as u32 % w, k as u32 / w))
+        else {
+            continue;
+        };
+        if *c != Some(true) {
+            continue;
+        }
+        let g = usize::from(p.material != glossy);
+        for ch in 0..3 {
+            let (a, b, e) = (img.data[k][ch], r.image.data[k][ch], r.stderr.data[k][ch]);
+            sums[g][0] += (a - b).powi(2) - e * e;
+            sums[g][1] += b * b - e * e;
+        }
+    }
+    let share = sums[0][0] / (sums[0][0] + sums[1][0]);
+    let others = (sums[1][0].max(0.0) / sums[1][1]).sqrt();
+    eprintln!(
+        "glossy sphere's share of the squared error {share:.3}; the others' rel L2 {others:.4}"
+    );
+    assert!(share > 0.7, "{share}");
+    assert!(others < 0.01, "{others}");
 }
 
 /// The noise-corrected relative L2 recovers a method's error against the noise-free image
