@@ -23,6 +23,11 @@
 //! The paper does not test
 //! visibility between an HVL and the receiver; here a shadow ray per pair does by default
 //! ([`Options::visibility`]), which the harness measures on the `room` scene.
+//!
+//! **Lattice** (not in the paper). The indirect light is computed on a lattice of every
+//! [`Options::stride`]-th pixel and interpolated between on the same object and normal
+//! ([`super::lattice`]); the plan takes the coarsest spacing whose probes stay within its
+//! share of the target ([`choose_stride`]). `stride = 1` is the paper's every pixel.
 
 use std::f64::consts::FRAC_PI_2;
 
