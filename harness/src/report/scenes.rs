@@ -19,8 +19,8 @@
 //! threshold, with the L2 cap fit and
 //! one lobe per occluder (instead of the default energy-preserving fit and quadtree mask)
 //! beside it; the `hvl` method's curve is its HVL count at the planned lattice stride
-//! (`scene::lattice`), with every pixel computed (the paper), the paper's choice of no HVL
-//! visibility and the direct light alone beside it (the one-core throughputs of its
+//! (`scene::lattice`), with every pixel computed (the paper), the other lattice spacings,
+//! the paper's choice of no HVL visibility and the direct light alone beside it (the one-core throughputs of its
 //! kernels are measured with every pixel computed); the `rsl` method's is its number
 //! of square lights `K`. Times
 //! are wall-clock seconds of whole renders on this machine's thread pool, both sides alike
@@ -385,6 +385,19 @@ fn hvl_settings<'a>(
             false,
         ),
     ];
+    // The other lattice spacings the plan weighs, for the speed-against-error trade.
+    variants.extend(
+        crate::scene::lattice::STRIDE_CANDIDATES
+            .iter()
+            .filter(|&&s| s != 1 && s != d.stride)
+            .map(|&stride| {
+                mk(
+                    format!("{hvls} HVLs, lattice spacing {stride}"),
+                    hvl::Options { stride, ..d },
+                    false,
+                )
+            }),
+    );
     if let Some(gpu) = gpu {
         variants.push(Setting {
             label: format!("{hvls} HVLs, every pixel, wgpu (diffuse indirect on the adapter)"),
