@@ -879,16 +879,11 @@ pub fn render(scene: &Scene, o: &Options, bar: &ProgressBar) -> (Image, usize) {
     let at = Placement::new(scene, place(scene, o.side));
     let glossy = Glossy::of(scene, o);
     let glossy = glossy.views();
-    let nodes = |ps: &[ShadingPoint]| -> Result<Vec<Rgb>, String> {
-        let mut scratch = Scratch::default();
-        Ok(ps
-            .iter()
-            .map(|p| indirect(scene, p, &at, o, &glossy, &mut scratch))
-            .collect())
-    };
-    let lattice = (o.stride > 1)
-        .then(|| lattice::Lattice::build(scene, o.stride, &nodes).ok())
-        .flatten();
+    let lattice = (o.stride > 1).then(|| {
+        lattice::Lattice::build(scene, o.stride, Scratch::default, |scratch, p| {
+            indirect(scene, p, &at, o, &glossy, scratch)
+        })
+    });
     let new_state = || (ProductCounts::default(), Scratch::default());
     let (img, _) =
         super::render_centres_x8_at(scene, bar, new_state, |(counts, scratch), pix, ps, out| {

@@ -12,11 +12,11 @@
 //! chooses `s` by what it costs elsewhere ([`strided_probes`]), and `s = 1` computes every
 //! pixel.
 //!
-//! Not for the `rsl` method's environment light, where it was tried and measured: on
-//! `environment` at 96 columns, `K = 30`, a spacing of 2 raised the mean |difference| from the path tracer from 7.5e-3 to 8.5e-3
-//! of the maximum (8.2e-3 with the glossy sphere computed at every pixel), and the probes'
-//! estimate, 3.4e-3, is five times a plan's share of the default target: the city's sun
-//! casts sharp shadows on the floor.
+//! Not for the `rsl` method's environment light, where it was tried: on `environment` the
+//! city's sun casts sharp shadows on the floor, and the probes' estimate at a spacing of 2
+//! was several times a plan's share of the default target.
+
+use std::collections::HashMap;
 
 use rayon::prelude::*;
 
@@ -31,12 +31,6 @@ pub const MIN_WEIGHT: f64 = 0.5;
 /// The lattice spacings a plan tries, coarsest first (1 is every pixel).
 pub const STRIDE_CANDIDATES: [usize; 4] = [4, 3, 2, 1];
 
-/// Points shaded per task when a lattice's nodes are shaded in parallel.
-const CHUNK: usize = 64;
-
-/// A method's shading of a set of points, one value each in order.
-pub type ShadeSet<'a> = dyn Fn(&[ShadingPoint]) -> Result<Vec<Rgb>, String> + Sync + 'a;
-
 /// The shaded nodes of a lattice over a scene's image.
 pub struct Lattice {
     stride: usize,
@@ -47,51 +41,39 @@ pub struct Lattice {
 }
 
 impl Lattice {
-    /// The lattice of spacing `stride` (at least 1) over `scene`'s image, the surface points
-    /// its nodes see shaded by `shade`, 64 at a time in parallel.
-    ///
-    /// Errors: `shade`'s.
-    pub fn build(scene: &Scene, stride: usize, shade: &ShadeSet<'_>) -> Result<Lattice, String> {
+    /// The lattice of spacing `stride` (at least 1) over `scene`'s image, the surface point
+    /// each node sees shaded by `shade(state, point)` in parallel (each task with a fresh
+    /// `new_state()`: scratch buffers).
+    pub fn build<S>(
+        scene: &Scene,
+        stride: usize,
+        new_state: impl Fn() -> S + Sync + Send,
+        shade: impl Fn(&mut S, &ShadingPoint) -> Rgb + Sync,
+    ) -> Lattice {
         let cam = scene.camera;
         let (w, h) = (cam.width as usize, cam.height as usize);
         let s = stride.max(1);
         let (columns, rows) = ((w - 1).div_ceil(s) + 1, (h - 1).div_ceil(s) + 1);
-        let seen: Vec<Option<ShadingPoint>> = (0..columns * rows)
+        let nodes = (0..columns * rows)
             .into_par_iter()
-            .map(|k| {
+            .map_init(new_state, |state, k| {
                 let (i, j) = (
                     ((k % columns) * s).min(w - 1),
                     ((k / columns) * s).min(h - 1),
                 );
                 match scene.see(&cam.centre_ray(i as u32, j as u32)) {
-                    Seen::Surface(p) => Some(p),
+                    Seen::Surface(p) => Some((p, shade(state, &p))),
                     Seen::Radiance(_) => None,
                 }
             })
             .collect();
-        let points: Vec<(usize, ShadingPoint)> = seen
-            .iter()
-            .enumerate()
-            .filter_map(|(k, p)| p.map(|p| (k, p)))
-            .collect();
-        let shaded: Vec<Vec<Rgb>> = points
-            .par_chunks(CHUNK)
-            .map(|c| {
-                let ps: Vec<ShadingPoint> = c.iter().map(|&(_, p)| p).collect();
-                shade(&ps)
-            })
-            .collect::<Result<_, _>>()?;
-        let mut nodes = vec![None; columns * rows];
-        for (&(k, p), v) in points.iter().zip(shaded.into_iter().flatten()) {
-            nodes[k] = Some((p, v));
-        }
-        Ok(Lattice {
+        Lattice {
             stride: s,
             width: w,
             height: h,
             columns,
             nodes,
-        })
+        }
     }
 
     /// The value at pixel `(i, j)`, which sees `p`, interpolated from its cell's corners;
@@ -154,7 +136,7 @@ pub fn interpolate_cell(
 
 /// The probe pixels ([`super::probe_pixels`]) shaded as a render at each spacing of
 /// [`STRIDE_CANDIDATES`] shades them, for a plan's [`super::plan_choice`]: each probe's
-/// cell corners shaded by `shade` and the rule applied, the probe's own value
+/// cell corners shaded by `shade` (each pixel once) and the rule applied, the probe's own value
 /// (`own[k]`, `shade` of probe `k`) where the rule refuses and at spacing 1; `base[k]` (a
 /// part every spacing computes alike, such as direct light) added to each.
 pub fn strided_probes(
@@ -166,6 +148,13 @@ pub fn strided_probes(
 ) -> Vec<Vec<Rgb>> {
     let cam = scene.camera;
     let (w, h) = (cam.width as usize, cam.height as usize);
+    // Every pixel shaded once, whichever spacings and probes share it as a corner (the
+    // probes themselves with their own values).
+    let mut seen: HashMap<(usize, usize), Option<(ShadingPoint, Rgb)>> = probes
+        .iter()
+        .zip(own)
+        .map(|(&(i, j, p), &v)| ((i, j), Some((p, v))))
+        .collect();
     STRIDE_CANDIDATES
         .iter()
         .map(|&s| {
@@ -178,13 +167,12 @@ pub fn strided_probes(
                     } else {
                         interpolate_cell(s, w, h, i, j, &p, |a, bb| {
                             let (x, y) = ((a * s).min(w - 1), (bb * s).min(h - 1));
-                            if (x, y) == (i, j) {
-                                return Some((p, mine));
-                            }
-                            match scene.see(&cam.centre_ray(x as u32, y as u32)) {
-                                Seen::Surface(q) => Some((q, shade(&q))),
-                                Seen::Radiance(_) => None,
-                            }
+                            *seen.entry((x, y)).or_insert_with(|| {
+                                match scene.see(&cam.centre_ray(x as u32, y as u32)) {
+                                    Seen::Surface(q) => Some((q, shade(&q))),
+                                    Seen::Radiance(_) => None,
+                                }
+                            })
                         })
                         .unwrap_or(mine)
                     };
