@@ -140,12 +140,11 @@ impl TableSize {
     /// Its name in plans and reports with its origin and size, e.g.
     /// `12×12×16 (generated, 4992 bytes)`.
     pub fn describe(self) -> String {
-        let (e, a) = self.dims();
-        let bytes = self.table().bytes();
-        match self {
-            TableSize::BuiltIn => format!("{e}×{e}×{a} (built in, {bytes} bytes)"),
-            _ => format!("{e}×{e}×{a} (generated, {bytes} bytes)"),
-        }
+        let origin = match self {
+            TableSize::BuiltIn => "built in",
+            _ => "generated",
+        };
+        format!("{self} ({origin}, {} bytes)", self.table().bytes())
     }
 
     /// The table: the committed one, or generated on first use in this process (the bytes
