@@ -964,7 +964,17 @@ fn assert_choice<T: Copy + PartialEq + std::fmt::Debug>(
 ) {
     let e: Vec<f64> = estimates.iter().map(|x| x.1).collect();
     assert!(e.windows(2).all(|w| w[1] <= w[0]), "{estimates:?}");
-    assert_eq!(e.last(), Some(&0.0), "{estimates:?}");
+    assert_first_within(estimates, chosen, target);
+}
+
+/// A plan's last estimate is 0 (the finest candidate stands in for the reference) and its
+/// choice is the first candidate within `PLAN_SHARE` of `target`.
+fn assert_first_within<T: Copy + PartialEq + std::fmt::Debug>(
+    estimates: &[(T, f64)],
+    chosen: T,
+    target: f64,
+) {
+    assert_eq!(estimates.last().map(|x| x.1), Some(0.0), "{estimates:?}");
     let first = estimates
         .iter()
         .find(|x| x.1 <= scene::PLAN_SHARE * target)
@@ -1228,13 +1238,10 @@ fn hvl_plans_the_indirect_lattice_from_the_target_error() {
     let planned = plan_at(&small.scene, render::Method::Hvl, target).hvl;
     let c = hvl::choose_stride(&small.scene, &planned, target);
     eprintln!("{c:?}");
-    assert_eq!(c.estimates.last(), Some(&(1, 0.0)));
-    let first = c
-        .estimates
-        .iter()
-        .find(|x| x.1 <= scene::PLAN_SHARE * target)
-        .map(|x| x.0);
-    assert_eq!(first, Some(c.stride));
+    // The estimates need not fall with the spacing (the probes sit on some lattices' nodes
+    // and not on others'), so only the rule of the choice is asserted.
+    assert_eq!(c.estimates.last().map(|x| x.0), Some(1));
+    assert_first_within(&c.estimates, c.stride, target);
     // The README's figure: spacing 3 on `room` at 64 columns.
     assert_eq!((planned.stride, c.stride), (3, 3));
     let hidden = ProgressBar::hidden();
@@ -1249,22 +1256,18 @@ fn hvl_plans_the_indirect_lattice_from_the_target_error() {
     )
     .0;
     let (w, s) = (strided.width, planned.stride);
-    let (mut nodes, mut sum, mut n) = (0, 0.0, 0);
-    let mut max: f64 = 0.0;
+    let mut nodes = 0;
     for (k, (a, b)) in strided.data.iter().zip(&every.data).enumerate() {
-        if small.class[k] != Some(true) {
-            continue;
-        }
         let (i, j) = (k % w, k / w);
-        if i % s == 0 && j % s == 0 {
+        if small.class[k] == Some(true) && i % s == 0 && j % s == 0 {
             assert_eq!(a, b, "node ({i}, {j})");
             nodes += 1;
         }
-        sum += (0..3).map(|c| (a[c] - b[c]).abs()).sum::<f64>() / 3.0;
-        n += 1;
-        max = max.max(b.iter().cloned().fold(0.0, f64::max));
     }
-    let gap = sum / n as f64 / max;
+    // The render's measure with the every-pixel image as the reference.
+    let gap = metrics::compare(&small.class, &strided, &every, None, 0.0)
+        .unwrap()
+        .mean_abs_over_max;
     eprintln!("stride {s}: {nodes} nodes, mean |strided − every pixel| = {gap:.2e} of max");
     assert!(nodes > 100 && gap > 0.0, "{nodes} {gap}");
     assert!(gap <= scene::PLAN_SHARE * target, "{gap:e}");
