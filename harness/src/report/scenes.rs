@@ -20,9 +20,9 @@
 //! one lobe per occluder (instead of the default energy-preserving fit and quadtree mask)
 //! beside it; the `hvl` method's curve is its HVL count at the planned lattice stride
 //! (`scene::lattice`), with every pixel computed (the paper), the other lattice spacings,
-//! the paper's choice of no HVL visibility and the direct light alone beside it (the one-core throughputs of its
-//! kernels are measured with every pixel computed); the `rsl` method's is its number
-//! of square lights `K`. Times
+//! the paper's choice of no HVL visibility and the direct light alone beside it (the
+//! one-core throughputs of its kernels are measured with every pixel computed); the `rsl`
+//! method's is its number of square lights `K`. Times
 //! are wall-clock seconds of whole renders on this machine's thread pool, both sides alike
 //! (the best of at least three runs, repeated for 0.25 s, for both).
 //! "Equal-error cost": the path tracer's time at the method's error, interpolated on its
