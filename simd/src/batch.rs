@@ -368,9 +368,11 @@ impl LobeX8 {
     }
 
     /// The eight lobes, rebuilt with [`CosineLobe::saturating`] (which normalises the axis,
-    /// clamps a negative exponent to 0 and keeps NaN). For lobes built by
-    /// [`CosineLobe::new`] or `saturating` this is the identity; an axis normalised
-    /// otherwise (the lobe product's result) may move by an ulp.
+    /// clamps a negative exponent to 0 and keeps NaN). The scale and a non-negative exponent
+    /// come back as they went in; an axis, even one `saturating` already normalised, may
+    /// move by an ulp (normalising a unit `f32` vector again is not always exact), so a
+    /// lane-by-lane comparison feeds the scalar kernel these lobes, not the ones the batch
+    /// was built from.
     #[inline]
     pub fn to_array(self) -> [CosineLobe; LANES] {
         let a = self.axis.to_array();
