@@ -16,11 +16,11 @@
 //! the truncation error of `n` bands without reconstructing anything:
 //! `e(n)² = (‖F‖² − Σ_{l<n} Σ_m F_l^m²)/‖F‖²`, and for a window `w_l`,
 //! `e_w(n)² = (‖F‖² − Σ_l (2w_l − w_l²) Σ_m F_l^m²)/‖F‖²`. [`choose_bands`] takes the
-//! fewest bands (3..=16) with `e(n) ≤ target` at `θₒ = 45°`, and [`choose_samples`] the
+//! fewest bands (3..=16) with `e(n) ≤ target` at `θₒ = 45°`, and [`choose_table`] the
 //! fewest views (from 16, 23, 30, 45, 90, 180) whose linear interpolation misses the
-//! coefficients at the midpoints by at most `target/10` of their norm; [`choose_table`]
-//! makes the same choice testing the midpoints from the grazing end and stopping at the
-//! first miss, and encodes the table from the views it projected on the way.
+//! coefficients at the midpoints by at most `target/10` of their norm, testing the
+//! midpoints from the grazing end and stopping at the first miss, and encodes the table
+//! from the views it projected on the way.
 
 use rayon::prelude::*;
 use steradian_core::sh::brdf::{self, BrdfSh, Part, TABLE_NAME, stored};
@@ -201,7 +201,7 @@ pub fn theta(k: usize, samples: usize) -> f64 {
     (k as f64 + 0.5) * std::f64::consts::FRAC_PI_2 / samples as f64
 }
 
-/// View counts [`choose_samples`] tries, in order (180 where none is enough).
+/// View counts [`choose_table`] tries, in order (180 where none is enough).
 pub const SAMPLE_COUNTS: [usize; 5] = [16, 23, 30, 45, 90];
 
 /// `(F, F′)` of one view.
@@ -258,14 +258,9 @@ fn interpolates(model: &Model, nodes: &Nodes, t: usize, target: f64) -> (bool, V
 }
 
 /// The fewest views of [`SAMPLE_COUNTS`] with interpolation error at most `target/10`
-/// (module docs), 180 where none is enough.
-pub fn choose_samples(model: &Model, bands: usize, target: f64) -> usize {
-    choose_table(model, bands, target).0
-}
-
-/// [`choose_samples`] and the [`table`] of that many views (file bytes), from the views the
-/// choice projected already: the same bytes as `table(model, bands, choose_samples(..))`
-/// (the same projections, each computed once).
+/// (module docs), 180 where none is enough, and the [`table`] of that many views (file
+/// bytes), from the views the choice projected already: the same bytes as `table(model,
+/// bands, views)` (the same projections, each computed once).
 pub fn choose_table(model: &Model, bands: usize, target: f64) -> (usize, Vec<u8>) {
     let nodes = Nodes::new(model.feature_angle(), bands, 1);
     for t in SAMPLE_COUNTS {
