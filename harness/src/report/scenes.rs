@@ -48,14 +48,14 @@ pub const WIDTH: u32 = 96;
 /// Samples per pixel of the `lobes` and `cluster` references. A noisy reference inflates
 /// the method's error and the path tracer's alike, and the path tracer's curve,
 /// extrapolated as `spp^−½` from a point that carries that noise, then reaches the method's
-/// error in too few samples: at 512 the noise (`reference_noise_over_max`) was about half
-/// the `lobes` method's error on both scenes.
+/// error in too few samples; each point reports the reference's noise
+/// (`reference_noise_over_max`) beside its errors, so the choice can be judged per run.
 pub const REFERENCE_SPP: u32 = 2048;
-/// Samples per pixel of the `room` reference (one bounce): at 512 its noise was nearly all
-/// of the `hvl` method's measured error.
+/// Samples per pixel of the `room` reference (one bounce), noisier per sample than the
+/// direct-light scenes'.
 pub const ROOM_REFERENCE_SPP: u32 = 4096;
-/// Samples per pixel of the `environment` reference: at 512 its noise
-/// (`reference_noise_over_max` in the report) was as large as the `rsl` method's error.
+/// Samples per pixel of the `environment` reference, the noisiest per sample (a sun in
+/// the environment and a glossy sphere).
 pub const ENVIRONMENT_REFERENCE_SPP: u32 = 4096;
 
 /// The reference's samples per pixel for a scene.
