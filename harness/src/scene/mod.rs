@@ -29,6 +29,7 @@ pub mod metrics;
 pub mod path;
 pub mod render;
 pub mod rsl;
+pub mod unshadowed;
 
 use std::path::Path;
 
