@@ -607,10 +607,12 @@ fn hvl_method_against_the_path_tracer_on_a_small_room() {
     assert!(with.rmse < direct.rmse);
 }
 
-/// The `rsl` method (K = 30) on a small `environment` scene against the path tracer (direct
-/// light): relative L2 within the bound measured here (the RSL paper's 0.35 % is not met;
-/// the test prints the measured errors), most of the squared error on the glossy sphere
-/// (measured 0.91 of it) and the other pixels alone within 1 % (measured 0.65 %).
+/// The `rsl` method (K = 30, with the shadow ratio) on a small `environment` scene against
+/// the path tracer (direct light): noise-corrected relative L2 within 1.2 % (measured
+/// 0.97 %; the RSL paper's 0.35 % is not met; the test prints the measured errors), under
+/// half the paper's pipeline's (no shadow ratio, measured 2.1 %), most of the squared error
+/// on the glossy sphere (measured 0.90 of it) and the other pixels alone within 0.5 %
+/// (measured 0.32 %).
 #[test]
 fn rsl_method_against_the_path_tracer_on_a_small_environment_scene() {
     use steradian_harness::scene::rsl;
@@ -623,15 +625,30 @@ fn rsl_method_against_the_path_tracer_on_a_small_environment_scene() {
     .unwrap();
     let m = small.errors(&img);
     eprintln!("rsl {m:?}");
-    assert!(m.rel_l2 < 0.035, "{m:?}");
-    // Against the noise-free image (the 32768-sample reference gives 2.0 %).
-    assert!(m.rel_l2_noise_corrected < 0.025, "{m:?}");
+    assert!(m.rel_l2 < 0.03, "{m:?}");
+    assert!(m.rel_l2_noise_corrected < 0.012, "{m:?}");
     assert!(
-        m.mean_abs_over_max < 0.012 + 4.0 * m.reference_noise_over_max,
+        m.mean_abs_over_max < 0.006 + 4.0 * m.reference_noise_over_max,
         "{m:?}"
     );
-    // Where the error is: the glossy sphere, which reflects the 30 uniform squares, holds
-    // most of the noise-corrected squared error; the other pixels alone are within 1 %.
+    let paper = small.errors(
+        &rsl::render(
+            &small.scene,
+            &rsl::Options {
+                exact_unshadowed: false,
+                ..rsl::Options::default()
+            },
+            &ProgressBar::hidden(),
+        )
+        .unwrap(),
+    );
+    eprintln!("rsl, the paper's pipeline {paper:?}");
+    assert!(
+        2.0 * m.rel_l2_noise_corrected < paper.rel_l2_noise_corrected,
+        "{m:?} vs {paper:?}"
+    );
+    // Where the error is: the glossy sphere holds most of the noise-corrected squared
+    // error; the other pixels alone are within 0.5 %.
     let s = &small.scene;
     let glossy = s.material_names.iter().position(|n| n == "glossy").unwrap();
     let (w, r) = (s.camera.width, &small.reference);
@@ -659,7 +676,7 @@ fn rsl_method_against_the_path_tracer_on_a_small_environment_scene() {
         "glossy sphere's share of the squared error {share:.3}; the others' rel L2 {others:.4}"
     );
     assert!(share > 0.7, "{share}");
-    assert!(others < 0.01, "{others}");
+    assert!(others < 0.005, "{others}");
 }
 
 /// The noise-corrected relative L2 recovers a method's error against the noise-free image
@@ -744,7 +761,8 @@ fn assert_pixels_close(a: &Image, b: &Image, tol: f64) -> (usize, f64) {
 
 /// The `rsl` method's SIMD path gives every pixel of the scalar path within the moments
 /// kernel's tolerance (relative to the pixel's largest channel), on `environment` (Phong
-/// and Lambert) and on [`MIXED`] (GGX and Lafortune too).
+/// and Lambert) and on [`MIXED`] (GGX and Lafortune too), with the shadow ratio (twice
+/// the tolerance: `S/U` carries the error of both) and without it (the paper's pipeline).
 #[test]
 fn rsl_simd_path_matches_the_scalar_path_pixel_by_pixel() {
     use steradian_harness::scene::rsl;
@@ -752,13 +770,21 @@ fn rsl_simd_path_matches_the_scalar_path_pixel_by_pixel() {
     let mut env = Scene::load("builtin:environment").unwrap();
     env.camera = env.camera.resized(40).unwrap();
     for (s, min_lit) in [(env, 1000), (mixed(MIXED).unwrap(), 800)] {
-        let o = rsl::Options::default();
-        let built = rsl::build(&s, &o).unwrap();
-        let hidden = ProgressBar::hidden();
-        let scalar = rsl::render_built(&s, &built, &o, &hidden);
-        let simd = rsl::render_built_simd(&s, &built, &o, &hidden).unwrap();
-        let (lit, _) = assert_pixels_close(&scalar, &simd, MOMENTS_REL_TOL as f64);
-        assert!(lit > min_lit, "{lit}");
+        for exact_unshadowed in [true, false] {
+            let o = rsl::Options {
+                exact_unshadowed,
+                ..rsl::Options::default()
+            };
+            let built = rsl::build(&s, &o).unwrap();
+            assert_eq!(built.unshadowed.is_some(), exact_unshadowed);
+            let hidden = ProgressBar::hidden();
+            let scalar = rsl::render_built(&s, &built, &o, &hidden).unwrap();
+            let simd = rsl::render_built_simd(&s, &built, &o, &hidden).unwrap();
+            let tol = if exact_unshadowed { 2.0 } else { 1.0 } * MOMENTS_REL_TOL as f64;
+            let (lit, worst) = assert_pixels_close(&scalar, &simd, tol);
+            eprintln!("ratio {exact_unshadowed}: worst {worst:.2e}");
+            assert!(lit > min_lit, "{lit}");
+        }
     }
 }
 
@@ -859,7 +885,7 @@ fn ggx_and_lafortune_materials_in_path_and_rsl() {
         5,
         "two GGX parts, two Lafortune lobes and a Phong exponent"
     );
-    let img = rsl::render_built(&s, &built, &o, &ProgressBar::hidden());
+    let img = rsl::render_built(&s, &built, &o, &ProgressBar::hidden()).unwrap();
     let class = metrics::classify(&s);
     let m = metrics::compare(&class, &img, &reference.image, Some(&reference.stderr), 0.0).unwrap();
     eprintln!("mixed rsl {m:?}");
@@ -902,9 +928,10 @@ fn rsl_gpu_path_matches_the_scalar_path_pixel_by_pixel() {
     let o = rsl::Options::default();
     let built = rsl::build(&s, &o).unwrap();
     let hidden = ProgressBar::hidden();
-    let scalar = rsl::render_built(&s, &built, &o, &hidden);
+    let scalar = rsl::render_built(&s, &built, &o, &hidden).unwrap();
     let on_gpu = rsl::render_built_gpu(&s, &built, &o, &mut gpu, &hidden).unwrap();
-    let (lit, worst) = assert_pixels_close(&scalar, &on_gpu, SHADE_MOMENTS_REL_TOL as f64);
+    // With the shadow ratio (the default): `S/U` carries the error of both.
+    let (lit, worst) = assert_pixels_close(&scalar, &on_gpu, 2.0 * SHADE_MOMENTS_REL_TOL as f64);
     gpu_common::say(&format!(
         "rsl scene on wgpu: {lit} lit pixels, worst {worst:.2e} of the pixel's largest channel"
     ));
@@ -986,8 +1013,9 @@ fn assert_first_within<T: Copy + PartialEq + std::fmt::Debug>(
 /// K is the smallest within `PLAN_SHARE` of the target (the visibility-map side, the
 /// coverage depth and the cube-map face by the same rule), a loose target takes a small K, and the
 /// render at the chosen K meets the target against the path tracer (plus four times the
-/// reference's noise) at 48 columns, with under half the noise-corrected relative L2 of
-/// the paper's K = 30.
+/// reference's noise) at 48 columns, with a smaller noise-corrected relative L2 than the
+/// paper's K = 30 (both with the shadow ratio, which leaves little to K on this small
+/// image: measured 0.91 % against 0.97 %).
 #[test]
 fn rsl_plans_k_from_the_target_error() {
     use steradian_harness::scene::rsl;
@@ -997,10 +1025,10 @@ fn rsl_plans_k_from_the_target_error() {
     let c = rsl::choose_k(&small.scene, &o, target).unwrap();
     eprintln!("{c:?}");
     assert_choice(&c.estimates, c.k, target);
-    // The visibility-map side by the same rule (the README's figure: 16 at 48 columns).
+    // The visibility-map side by the same rule (the README's figure: 32 at 48 columns).
     assert_eq!(c.side_estimates.last(), Some(&(64, 0.0)));
     assert_choice(&c.side_estimates, c.vis_side, target);
-    assert_eq!(c.vis_side, 16);
+    assert_eq!(c.vis_side, 32);
     // The coverage depth by the same rule, from 0 to the bound-based depth (the
     // estimates need not fall with depth: each level's leaves err on either side).
     assert_eq!(c.depth_estimates.last(), Some(&(o.vis_depth, 0.0)));
@@ -1015,7 +1043,9 @@ fn rsl_plans_k_from_the_target_error() {
     // The cube-map face by the same rule, every candidate holding K texels.
     assert_eq!(c.face_estimates.last(), Some(&(64, 0.0)));
     assert!(c.face_estimates.iter().all(|&(f, _)| 6 * f * f >= c.k));
-    assert_choice(&c.face_estimates, c.face, target);
+    // With the shadow ratio the faces below the largest differ by less than their
+    // estimates' spread (measured 7.0e-4 at 16, 7.2e-4 at 32): they need not fall.
+    assert_first_within(&c.face_estimates, c.face, target);
     let loose = rsl::choose_k(&small.scene, &o, 0.05).unwrap();
     assert!(loose.k < c.k, "{loose:?}");
     assert!(loose.vis_side <= c.vis_side, "{loose:?}");
@@ -1041,7 +1071,7 @@ fn rsl_plans_k_from_the_target_error() {
         m.mean_abs_over_max < target + 4.0 * m.reference_noise_over_max,
         "{m:?}"
     );
-    // Against the noise-free image the planned K is well below the paper's K = 30.
+    // Against the noise-free image the planned K is below the paper's K = 30.
     let paper = small.errors(
         &rsl::render(
             &small.scene,
@@ -1051,7 +1081,7 @@ fn rsl_plans_k_from_the_target_error() {
         .unwrap(),
     );
     assert!(
-        m.rel_l2_noise_corrected < 0.5 * paper.rel_l2_noise_corrected,
+        m.rel_l2_noise_corrected < paper.rel_l2_noise_corrected,
         "{m:?} vs K = 30: {paper:?}"
     );
 }

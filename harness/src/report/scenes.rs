@@ -451,24 +451,34 @@ fn rsl_settings<'a>(
             k: paper_k,
             ..p.rsl
         });
-    let setting = |k: usize, kernel: RslKernel| {
-        let o = rsl::Options { k, ..d };
+    // `ratio`: the shadow ratio (the default), or the paper's pipeline without it.
+    let setting = |k: usize, kernel: RslKernel, ratio: bool| {
+        let o = rsl::Options {
+            k,
+            exact_unshadowed: ratio,
+            ..d
+        };
         let (built, build_seconds) = timed(|| rsl::build(scene, &o));
         let (suffix, name) = match kernel {
             RslKernel::Scalar => (", scalar kernel", "scalar"),
             RslKernel::Simd => ("", "simd"),
             RslKernel::Wgpu => (", wgpu", "wgpu"),
         };
-        let default = k == d.k && kernel == RslKernel::Simd;
+        let paper = if ratio {
+            ""
+        } else {
+            ", the paper's pipeline (no shadow ratio)"
+        };
+        let default = k == d.k && kernel == RslKernel::Simd && ratio == d.exact_unshadowed;
         Setting {
-            label: format!("K = {k}{suffix}"),
+            label: format!("K = {k}{suffix}{paper}"),
             render: Box::new(move || {
                 let hidden = ProgressBar::hidden();
                 let img = built
                     .as_ref()
                     .map_err(Clone::clone)
                     .and_then(|b| match kernel {
-                        RslKernel::Scalar => Ok(rsl::render_built(scene, b, &o, &hidden)),
+                        RslKernel::Scalar => rsl::render_built(scene, b, &o, &hidden),
                         RslKernel::Simd => rsl::render_built_simd(scene, b, &o, &hidden),
                         RslKernel::Wgpu => {
                             let mut g = gpu
@@ -484,16 +494,21 @@ fn rsl_settings<'a>(
             }),
             default,
             build_seconds: Some(build_seconds),
-            per_core: (default || kernel != RslKernel::Simd).then_some(name),
+            per_core: (ratio == d.exact_unshadowed && (default || kernel != RslKernel::Simd))
+                .then_some(name),
         }
     };
+    let ratio = d.exact_unshadowed;
     let curve = RSL_KS
         .iter()
-        .map(|&k| setting(k, RslKernel::Simd))
+        .map(|&k| setting(k, RslKernel::Simd, ratio))
         .collect();
-    let mut variants = vec![setting(d.k, RslKernel::Scalar)];
+    let mut variants = vec![
+        setting(d.k, RslKernel::Simd, !ratio),
+        setting(d.k, RslKernel::Scalar, ratio),
+    ];
     if gpu.is_some() {
-        variants.push(setting(d.k, RslKernel::Wgpu));
+        variants.push(setting(d.k, RslKernel::Wgpu, ratio));
     }
     (curve, variants)
 }

@@ -228,6 +228,16 @@ pub fn plan(scene: &Scene, o: &Options) -> Result<Plan, String> {
                 ),
             });
             p.push(PlanItem {
+                item: "shadow_ratio".into(),
+                value: json!(r.exact_unshadowed),
+                reason: format!(
+                    "each BRDF part's exact unshadowed integral from environment tables (the \
+                     diffuse one; one per glossy lobe exponent up to {}, not GGX) times the \
+                     squares' shadowed-to-unshadowed ratio; off, the RSL paper's eq. 5 alone",
+                    super::unshadowed::MAX_EXPONENT
+                ),
+            });
+            p.push(PlanItem {
                 item: "brdf_sats".into(),
                 value: json!(r.sat_target),
                 reason: "one Lambert SAT and one per distinct specular part (Phong exponent, \
@@ -601,7 +611,7 @@ pub fn run(scene: &Scene, scene_name: &str, o: &Options, plan: &Plan) -> Result<
                     .map_err(|e| format!("--gpu: no wgpu adapter: {e}"))?;
                 super::rsl::render_built_gpu(scene, &built, &plan.rsl, &mut gpu, &b)?
             } else if o.scalar {
-                super::rsl::render_built(scene, &built, &plan.rsl, &b)
+                super::rsl::render_built(scene, &built, &plan.rsl, &b)?
             } else {
                 super::rsl::render_built_simd(scene, &built, &plan.rsl, &b)?
             };

@@ -31,7 +31,8 @@ use steradian_core::rsl::vis_moments::VisMoments;
 use steradian_core::rsl::visibility::{Outside, coverage_into_depth, local_cap};
 
 use super::image::Image;
-use super::material::Material;
+use super::material::{Material, reflect};
+use super::unshadowed::EnvTables;
 use super::{Rgb, Scene, Seen, ShadingPoint, Shape, render_centres};
 use crate::env::Equirect;
 use crate::env::decompose::{Decomposition, decompose};
@@ -50,6 +51,12 @@ pub struct Options {
     /// Subdivision levels below a visibility texel
     /// ([`steradian_core::rsl::visibility::coverage_into_depth`]).
     pub vis_depth: u32,
+    /// The shadow ratio (an addition to the paper's pipeline, on by default): each BRDF
+    /// part's exact unshadowed integral from environment tables
+    /// ([`super::unshadowed::EnvTables`]) times the kernel's shadowed-to-unshadowed ratio
+    /// `S/U` (both over the same squares), instead of `S` alone. Off, the method is the
+    /// paper's pipeline.
+    pub exact_unshadowed: bool,
 }
 
 impl Default for Options {
@@ -60,6 +67,7 @@ impl Default for Options {
             vis_side: 32,
             sat_target: 0.005,
             vis_depth: coverage_depth_for(super::DEFAULT_TARGET_ERROR),
+            exact_unshadowed: true,
         }
     }
 }
@@ -82,6 +90,8 @@ pub struct Built {
     pub lambert: BrdfSat,
     /// The specular SATs by [`SpecKey`].
     pub specular: BTreeMap<SpecKey, BrdfSat>,
+    /// The exact unshadowed integrals ([`Options::exact_unshadowed`]).
+    pub unshadowed: Option<EnvTables>,
 }
 
 /// Decomposes the environment and fits the SATs the materials need.
@@ -91,7 +101,32 @@ pub fn build(scene: &Scene, o: &Options) -> Result<Built, String> {
         lights: many.lights.remove(0).1,
         lambert: many.lambert,
         specular: many.specular,
+        unshadowed: many.unshadowed,
     })
+}
+
+/// The environment tables of [`Options::exact_unshadowed`]: the diffuse one and one per
+/// glossy lobe exponent of the specular parts (Phong, Lafortune; GGX keeps the squares'
+/// estimate).
+fn env_tables(scene: &Scene, specular: &BTreeMap<SpecKey, BrdfSat>) -> Option<EnvTables> {
+    let env = scene.environment.as_ref()?;
+    let exponents: Vec<f64> = specular
+        .keys()
+        .filter_map(|k| match *k {
+            SpecKey::Phong(e) | SpecKey::Lafortune(_, _, e) => Some(f64::from_bits(e)),
+            SpecKey::Ggx(..) => None,
+        })
+        .collect();
+    Some(EnvTables::build(env, &exponents))
+}
+
+/// The visibility moment tables of a point that sees everything, at `side`² (the `U` of
+/// the shadow ratio).
+pub fn free_moments(o: &Options) -> Result<VisMoments, String> {
+    let mut cov = vec![0.0f32; o.vis_side * o.vis_side];
+    coverage_into_depth(&[], o.vis_side, Outside::Visible, o.vis_depth, &mut cov)
+        .map_err(|e| e.to_string())?;
+    VisMoments::build_coverage(o.vis_side, &cov).map_err(|e| e.to_string())
 }
 
 /// The environment (times its scale) resampled to a cube map of `face`² texels per face and
@@ -141,6 +176,8 @@ pub struct BuiltMany {
     pub lambert: BrdfSat,
     /// The specular SATs by [`SpecKey`].
     pub specular: BTreeMap<SpecKey, BrdfSat>,
+    /// The exact unshadowed integrals ([`Options::exact_unshadowed`]).
+    pub unshadowed: Option<EnvTables>,
 }
 
 /// The environment (times its scale) decomposed into each of `ks` square lights, and the
@@ -161,10 +198,16 @@ pub fn build_many(scene: &Scene, o: &Options, ks: &[usize]) -> Result<BuiltMany,
             }
         }
     }
+    let unshadowed = if o.exact_unshadowed {
+        env_tables(scene, &specular)
+    } else {
+        None
+    };
     Ok(BuiltMany {
         lights,
         lambert,
         specular,
+        unshadowed,
     })
 }
 
@@ -233,7 +276,9 @@ pub fn choose_k(scene: &Scene, o: &Options, target: f64) -> Result<KChoice, Stri
         lights: by_k,
         lambert,
         specular,
+        unshadowed,
     } = build_many(scene, o, &ks)?;
+    let free = free_moments(o)?;
     let mut cov = vec![0.0f32; o.vis_side * o.vis_side];
     let points = super::probe_points(scene);
     let probes: Vec<_> = points
@@ -245,6 +290,7 @@ pub fn choose_k(scene: &Scene, o: &Options, target: f64) -> Result<KChoice, Stri
         lights: Vec::new(),
         lambert,
         specular,
+        unshadowed,
     };
     let (mut order, mut images, mut lights_of) = (Vec::new(), Vec::new(), Vec::new());
     for (k, lights) in by_k {
@@ -252,7 +298,7 @@ pub fn choose_k(scene: &Scene, o: &Options, target: f64) -> Result<KChoice, Stri
         images.push(
             probes
                 .iter()
-                .map(|(p, (frame, m))| shade_with(scene, &b, p, frame, m))
+                .map(|(p, (frame, m))| shade_with(scene, &b, p, frame, m, &free))
                 .collect::<Vec<Rgb>>(),
         );
         order.push(k);
@@ -266,10 +312,13 @@ pub fn choose_k(scene: &Scene, o: &Options, target: f64) -> Result<KChoice, Stri
     // The probes shaded with the chosen K's lights and the maps of `os`.
     let shaded = |os: &Options| -> Vec<Rgb> {
         let mut cov = vec![0.0f32; os.vis_side * os.vis_side];
+        let Ok(free) = free_moments(os) else {
+            return vec![[0.0; 3]; points.len()];
+        };
         points
             .iter()
             .map(|p| match point_moments(scene, os, p, &mut cov) {
-                Some((frame, m)) => shade_with(scene, &b, p, &frame, &m),
+                Some((frame, m)) => shade_with(scene, &b, p, &frame, &m, &free),
                 None => [0.0; 3],
             })
             .collect()
@@ -307,6 +356,7 @@ pub fn choose_k(scene: &Scene, o: &Options, target: f64) -> Result<KChoice, Stri
         ..*o
     };
     let mut cov = vec![0.0f32; vis_side * vis_side];
+    let free = free_moments(&os)?;
     let probes: Vec<_> = points
         .iter()
         .filter_map(|p| point_moments(scene, &os, p, &mut cov).map(|t| (p, t)))
@@ -328,7 +378,7 @@ pub fn choose_k(scene: &Scene, o: &Options, target: f64) -> Result<KChoice, Stri
         face_images.push(
             probes
                 .iter()
-                .map(|(p, (frame, m))| shade_with(scene, &b, p, frame, m))
+                .map(|(p, (frame, m))| shade_with(scene, &b, p, frame, m, &free))
                 .collect::<Vec<Rgb>>(),
         );
     }
@@ -449,31 +499,82 @@ fn fit_part(
     })
 }
 
-/// The reflected radiance from the diffuse integral `d` and the integral of each specular
-/// part with its RGB scale ([`shade::shade_moments`] with the Lambert SAT and each part's).
-fn combine(mat: &Material, d: [f32; 3], parts: impl IntoIterator<Item = (Rgb, [f32; 3])>) -> Rgb {
-    let diffuse = mat.diffuse();
-    let mut out: Rgb = core::array::from_fn(|c| diffuse[c] * d[c] as f64);
-    for (scale, s) in parts {
+/// The exact unshadowed integral of one BRDF part at a point, with unit scale like its
+/// SAT, and its weight ([`EnvTables::lobe`]): Lambert `(1/π)∫L·cos⁺`; modified Phong
+/// `(e+2)/(2π)·∫L·(r·ω)₊^e·cos⁺` about the mirror direction `r`; a Lafortune lobe
+/// `∫L·(m·ω)₊^e·cos⁺ = |m|^e·∫L·(â·ω)₊^e·cos⁺` with `m = (c·ωo_x, c·ωo_y, c_z·ωo_z)` in
+/// the local frame and `â = m/|m|`. `None` where the tables have none (GGX, a sharper
+/// lobe than [`super::unshadowed::MAX_EXPONENT`], an axis too near the horizon).
+fn exact_part(t: &EnvTables, key: Option<SpecKey>, p: &ShadingPoint) -> Option<(Rgb, f64)> {
+    let (n, wo) = (p.n, p.wo);
+    match key {
+        None => Some((t.diffuse(n), 1.0)),
+        Some(SpecKey::Phong(e)) => {
+            let e = f64::from_bits(e);
+            let (v, w) = t.lobe(e, reflect(wo, n), n)?;
+            let k = (e + 2.0) / std::f64::consts::TAU;
+            Some((v.map(|x| x * k), w))
+        }
+        Some(SpecKey::Lafortune(c, cz, e)) => {
+            let (c, cz, e) = (f64::from_bits(c), f64::from_bits(cz), f64::from_bits(e));
+            let z = wo.dot(n);
+            let m = c * (wo - z * n) + cz * z * n;
+            let len = m.length();
+            if len.is_nan() || len <= 0.0 {
+                return None;
+            }
+            let (v, w) = t.lobe(e, m / len, n)?;
+            let k = len.powf(e);
+            Some((v.map(|x| x * k), w))
+        }
+        Some(SpecKey::Ggx(..)) => None,
+    }
+}
+
+/// One part's integral: the kernel's `s`, or with the shadow ratio
+/// ([`Options::exact_unshadowed`]) `x·clamp(s/u, 0, 1)` per channel (`u` the kernel's
+/// unshadowed twin, `x` the exact unshadowed integral), blended with `s` by `x`'s weight.
+/// `s` alone where `u` is not positive (the squares bring that channel no light).
+fn part_value(s: [f32; 3], u: Option<[f32; 3]>, x: Option<(Rgb, f64)>) -> Rgb {
+    let mut out = s.map(f64::from);
+    if let (Some(u), Some((x, w))) = (u, x) {
         for c in 0..3 {
-            out[c] += scale[c] * s[c] as f64;
+            let (sc, uc) = (s[c] as f64, u[c] as f64);
+            if uc > 0.0 && sc.is_finite() && x[c].is_finite() {
+                let ratio = (sc / uc).clamp(0.0, 1.0);
+                out[c] = w * x[c] * ratio + (1.0 - w) * sc;
+            }
         }
     }
     out
 }
 
-/// The reflected radiance at a surface point.
+/// The reflected radiance from each part's value with its RGB scale (the diffuse part's
+/// scale is the material's diffuse RGB).
+fn combine(mat: &Material, d: Rgb, parts: impl IntoIterator<Item = (Rgb, Rgb)>) -> Rgb {
+    let diffuse = mat.diffuse();
+    let mut out: Rgb = core::array::from_fn(|c| diffuse[c] * d[c]);
+    for (scale, s) in parts {
+        for c in 0..3 {
+            out[c] += scale[c] * s[c];
+        }
+    }
+    out
+}
+
+/// The reflected radiance at a surface point (`free` from [`free_moments`] at `o`).
 pub fn shade_point(
     scene: &Scene,
     b: &Built,
     o: &Options,
     p: &ShadingPoint,
     cov: &mut [f32],
+    free: &VisMoments,
 ) -> Rgb {
     let Some((frame, moments)) = point_moments(scene, o, p, cov) else {
         return [0.0; 3];
     };
-    shade_with(scene, b, p, &frame, &moments)
+    shade_with(scene, b, p, &frame, &moments, free)
 }
 
 /// [`shade_point`] with the point's frame and moment tables already built.
@@ -483,42 +584,74 @@ fn shade_with(
     p: &ShadingPoint,
     frame: &Frame,
     moments: &VisMoments,
+    free: &VisMoments,
 ) -> Rgb {
     let wo = p.wo.as_vec3();
     let mat = &scene.materials[p.material];
-    let d = shade::shade_moments(frame, wo, &b.lambert, moments, &b.lights);
+    let part = |key: Option<SpecKey>, sat: &BrdfSat| {
+        let s = shade::shade_moments(frame, wo, sat, moments, &b.lights);
+        let Some(t) = &b.unshadowed else {
+            return part_value(s, None, None);
+        };
+        let x = exact_part(t, key, p);
+        let u = x.map(|_| shade::shade_moments(frame, wo, sat, free, &b.lights));
+        part_value(s, u, x)
+    };
+    let d = part(None, &b.lambert);
     let parts = specular_parts(mat).filter_map(|(key, scale)| {
         let sat = b.specular.get(&key)?;
-        Some((
-            scale,
-            shade::shade_moments(frame, wo, sat, moments, &b.lights),
-        ))
+        Some((scale, part(Some(key), sat)))
     });
     combine(mat, d, parts)
 }
 
 /// A kernel run over a set of points with one BRDF SAT: `None` the Lambert SAT, `Some(key)`
-/// a specular part's; `sel` indexes the caller's points; one integral per selected point.
-type PartBatch<'a> = dyn FnMut(Option<SpecKey>, &[usize]) -> Result<Vec<[f32; 3]>, String> + 'a;
+/// a specular part's; `sel` indexes the caller's points; with `free`, every point seeing
+/// everything ([`free_moments`]); one integral per selected point.
+type PartBatch<'a> =
+    dyn FnMut(Option<SpecKey>, &[usize], bool) -> Result<Vec<[f32; 3]>, String> + 'a;
 
 /// The radiance of points shaded part by part, the batched twin of [`shade_with`]:
-/// `materials[q]` is point `q`'s material; `batch` shades all points with the Lambert SAT,
-/// then, per specular part of [`Built::specular`], the points whose material has it; each
-/// point's integrals are then combined with its diffuse RGB and the parts' scales.
+/// `batch` shades all `points` with the Lambert SAT, then, per specular part of
+/// [`Built::specular`], the points whose material has it (and, with the shadow ratio, the
+/// same seeing everything, where the part has an exact value); each point's integrals are
+/// then combined with its diffuse RGB and the parts' scales.
 fn shade_by_part(
     scene: &Scene,
     built: &Built,
-    materials: &[usize],
+    points: &[ShadingPoint],
     batch: &mut PartBatch<'_>,
 ) -> Result<Vec<Rgb>, String> {
-    let all: Vec<usize> = (0..materials.len()).collect();
-    let d = batch(None, &all)?;
-    let mut parts: Vec<Vec<(Rgb, [f32; 3])>> = vec![Vec::new(); materials.len()];
+    // One part over the points `sel`: the kernel's values through the ratio.
+    let mut part = |key: Option<SpecKey>, sel: &[usize]| -> Result<Vec<Rgb>, String> {
+        let s = batch(key, sel, false)?;
+        let Some(t) = &built.unshadowed else {
+            return Ok(s.into_iter().map(|v| part_value(v, None, None)).collect());
+        };
+        let x: Vec<Option<(Rgb, f64)>> = sel
+            .iter()
+            .map(|&q| exact_part(t, key, &points[q]))
+            .collect();
+        let with: Vec<usize> = (0..sel.len()).filter(|&i| x[i].is_some()).collect();
+        let sub: Vec<usize> = with.iter().map(|&i| sel[i]).collect();
+        let mut u: Vec<Option<[f32; 3]>> = vec![None; sel.len()];
+        if !sub.is_empty() {
+            for (&i, v) in with.iter().zip(batch(key, &sub, true)?) {
+                u[i] = Some(v);
+            }
+        }
+        Ok((0..sel.len())
+            .map(|i| part_value(s[i], u[i], x[i]))
+            .collect())
+    };
+    let all: Vec<usize> = (0..points.len()).collect();
+    let d = part(None, &all)?;
+    let mut parts: Vec<Vec<(Rgb, Rgb)>> = vec![Vec::new(); points.len()];
     for key in built.specular.keys() {
         let (sel, scales): (Vec<usize>, Vec<Rgb>) = all
             .iter()
             .filter_map(|&q| {
-                specular_parts(&scene.materials[materials[q]])
+                specular_parts(&scene.materials[points[q].material])
                     .find(|(pk, _)| pk == key)
                     .map(|(_, scale)| (q, scale))
             })
@@ -526,15 +659,15 @@ fn shade_by_part(
         if sel.is_empty() {
             continue;
         }
-        let s = batch(Some(*key), &sel)?;
+        let s = part(Some(*key), &sel)?;
         for ((&q, v), scale) in sel.iter().zip(s).zip(scales) {
             parts[q].push((scale, v));
         }
     }
-    Ok((0..materials.len())
+    Ok((0..points.len())
         .map(|q| {
             combine(
-                &scene.materials[materials[q]],
+                &scene.materials[points[q].material],
                 d[q],
                 parts[q].iter().copied(),
             )
@@ -572,6 +705,7 @@ pub fn render_built_simd(
         tables: &lambert_views,
         s_max: built.lambert.s_max(),
     };
+    let free = free_moments(o)?;
     let cam = scene.camera;
     let (w, h) = (cam.width as usize, cam.height as usize);
     let rows: Vec<Result<Vec<Rgb>, String>> = (0..h)
@@ -591,8 +725,8 @@ pub fn render_built_simd(
                     }
                 }
             }
-            let materials: Vec<usize> = pts.iter().map(|p| p.1.material).collect();
-            let mut batch = |key: Option<SpecKey>, sel: &[usize]| {
+            let points: Vec<ShadingPoint> = pts.iter().map(|p| p.1).collect();
+            let mut batch = |key: Option<SpecKey>, sel: &[usize], see_all: bool| {
                 let tables = match key {
                     None => lambert,
                     Some(k) => {
@@ -608,7 +742,11 @@ pub fn render_built_simd(
                     .map(|&q| MomentsInput {
                         frame: pts[q].2,
                         wo: pts[q].1.wo.as_vec3(),
-                        vis: pts[q].3.view(),
+                        vis: if see_all {
+                            free.view()
+                        } else {
+                            pts[q].3.view()
+                        },
                     })
                     .collect();
                 let mut out = vec![[0.0f32; 3]; sel.len()];
@@ -618,7 +756,7 @@ pub fn render_built_simd(
                     Err("visibility tables of different sizes".to_string())
                 }
             };
-            let shaded = shade_by_part(scene, built, &materials, &mut batch)?;
+            let shaded = shade_by_part(scene, built, &points, &mut batch)?;
             for ((i, _, _, _), v) in pts.iter().zip(shaded) {
                 row[*i] = v;
             }
@@ -636,17 +774,24 @@ pub fn render_built_simd(
 /// One pixel-centre sample per pixel ([`super::render_centres`]), building first.
 pub fn render(scene: &Scene, o: &Options, bar: &ProgressBar) -> Result<Image, String> {
     let built = build(scene, o)?;
-    Ok(render_built(scene, &built, o, bar))
+    render_built(scene, &built, o, bar)
 }
 
 /// [`render`] with what [`build`] made: the per-frame work once the environment is
 /// decomposed and the BRDF tables fitted (the paper's precomputation).
-pub fn render_built(scene: &Scene, built: &Built, o: &Options, bar: &ProgressBar) -> Image {
+/// `Err` for a visibility-map side the moment tables do not take.
+pub fn render_built(
+    scene: &Scene,
+    built: &Built,
+    o: &Options,
+    bar: &ProgressBar,
+) -> Result<Image, String> {
+    let free = free_moments(o)?;
     let new_cov = || vec![0.0f32; o.vis_side * o.vis_side];
     let (img, _) = render_centres(scene, bar, new_cov, |cov, p| {
-        shade_point(scene, built, o, p, cov)
+        shade_point(scene, built, o, p, cov, &free)
     });
-    img
+    Ok(img)
 }
 
 /// Surface points shaded per GPU batch by [`render_built_gpu`] (their moment tables are
@@ -669,6 +814,7 @@ pub fn render_built_gpu(
     use crate::shade::{GPU_MOMENTS_MAX_TABLE_BYTES, ShadePoint, shade_moments_gpu_at};
     use rayon::prelude::*;
 
+    let free = free_moments(o)?;
     let cam = scene.camera;
     let (w, h) = (cam.width as usize, cam.height as usize);
     let mut img = Image::new(w, h);
@@ -692,11 +838,13 @@ pub fn render_built_gpu(
             )
             .collect();
         // The shaded points of the batch (those with tables) with their pixel.
+        let mut points = Vec::new();
         let mut px = Vec::new();
         let mut pts = Vec::new();
         let mut ms = Vec::new();
         for ((k, p), t) in chunk.iter().zip(tables) {
             if let Some((frame, m)) = t {
+                points.push(*p);
                 px.push((*k, p.material));
                 pts.push(ShadePoint {
                     pos: p.x,
@@ -707,14 +855,16 @@ pub fn render_built_gpu(
                 ms.push(m);
             }
         }
-        let materials: Vec<usize> = px.iter().map(|&(_, mi)| mi).collect();
-        let mut batch = |key: Option<SpecKey>, sel: &[usize]| {
+        let mut batch = |key: Option<SpecKey>, sel: &[usize], see_all: bool| {
             let sat = match key {
                 None => &built.lambert,
                 Some(k) => &built.specular[&k],
             };
             let sub_pts: Vec<ShadePoint> = sel.iter().map(|&q| pts[q].clone()).collect();
-            let sub_ms: Vec<&VisMoments> = sel.iter().map(|&q| &ms[q]).collect();
+            let sub_ms: Vec<&VisMoments> = sel
+                .iter()
+                .map(|&q| if see_all { &free } else { &ms[q] })
+                .collect();
             shade_moments_gpu_at(
                 gpu,
                 &sub_pts,
@@ -725,7 +875,7 @@ pub fn render_built_gpu(
             )
             .map_err(|e| e.to_string())
         };
-        let shaded = shade_by_part(scene, built, &materials, &mut batch)?;
+        let shaded = shade_by_part(scene, built, &points, &mut batch)?;
         for (&(k, _), v) in px.iter().zip(shaded) {
             img.data[k] = v;
         }
