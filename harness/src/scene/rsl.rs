@@ -14,6 +14,11 @@
 //!   every plane the point is not on (a plane seen from a point off it is exactly the
 //!   hemisphere of directions toward it: a cap of half-angle π/2), on an
 //!   [`Options::vis_side`]² grid of the hemisphere map, turned into moment tables.
+//! - By default ([`Options::exact_unshadowed`], an addition to the paper) each part's
+//!   value is its exact unshadowed integral ([`super::unshadowed`]) times the kernel's
+//!   ratio `S/U` of the point's value to the same with nothing occluded, where the part
+//!   has such an integral (Lambert, Phong and Lafortune lobes up to exponent
+//!   [`super::unshadowed::MAX_EXPONENT`]); GGX keeps `S`.
 //! - Spherical lights are not lit by this method (the `lobes` method lights with them);
 //!   they are seen by the camera and occlude.
 
