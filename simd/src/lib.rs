@@ -17,7 +17,7 @@
 //! | [`sh::hvl`] | [`sh::hvl::contributions_x4`] (four HVLs, one receiver) | `contributions` | bit-identical |
 //! | [`sh::irradiance`] | [`sh::irradiance::irradiance_x4`] (one radiance vector, four normals) | `irradiance_slices` | bit-identical |
 //! | [`cp`] | (one function at many directions) | [`cp::query_slices`] | bit-identical (gnomonic weights), within [`cp::AREA_TOL`] (area weights) |
-//! | [`rsl::shade`] | [`rsl::shade::shade_x8`], [`rsl::shade::shade_moments_x8`] | `shade_batch`, `shade_moments_batch` | within [`rsl::shade::REL_TOL`], [`rsl::shade::MOMENTS_REL_TOL`] |
+//! | [`rsl::shade`] | [`rsl::shade::shade_x8`], [`rsl::shade::shade_moments_x8`], [`rsl::shade::shade_moments_pair_x8`] | `shade_batch`, `shade_moments_batch`, `shade_moments_pair_batch` | within [`rsl::shade::REL_TOL`], [`rsl::shade::MOMENTS_REL_TOL`] |
 //!
 //! The folders are those of `steradian-core`, one per paper (`lobe/`, `rsl/`, `sh/`, `cp`).
 //!

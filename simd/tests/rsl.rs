@@ -15,7 +15,8 @@ use steradian_core::rsl::shade::{self as core_shade, ShadeLight, VdtQuery, VdtVi
 use steradian_core::rsl::vdt::{FIT_WIDE_R, R_MAX, R_MIN, Vdt, VdtView};
 use steradian_core::rsl::vis_moments::VisMoments;
 use steradian_simd::rsl::shade::{
-    IsoBrdfTables, MOMENTS_REL_TOL, MomentsInput, REL_TOL, ShadeInput, shade_moments_x8, shade_x8,
+    IsoBrdfTables, MOMENTS_REL_TOL, MomentsInput, REL_TOL, ShadeInput, shade_moments_pair_x8,
+    shade_moments_x8, shade_x8,
 };
 use steradian_simd::rsl::{sat, vdt};
 
@@ -468,12 +469,22 @@ fn check_moments(s: &Setup, pts: &[(Frame, Vec3); 8], lights: &[ShadeLight]) -> 
         vis: s.moments[k].view(),
     });
     let out = shade_moments_x8(&input, &tables, lights).expect("same sizes");
+    // The pair kernel: its `S` is the kernel's bit for bit, its `U` the scalar pair's.
+    let (s_pair, u_pair) = shade_moments_pair_x8(&input, &tables, lights).expect("same sizes");
+    let bits = |v: [f32; 3]| v.map(f32::to_bits);
     for (k, p) in input.iter().enumerate() {
         let want = core_shade::shade_moments(&p.frame, p.wo, &s.sat, &p.vis, lights);
         assert!(
             close(out[k], want, MOMENTS_REL_TOL),
             "moments lane {k}: {:?} vs {want:?}",
             out[k]
+        );
+        assert_eq!(bits(s_pair[k]), bits(out[k]), "pair lane {k}");
+        let (_, u) = core_shade::shade_moments_pair(&p.frame, p.wo, &s.sat, &p.vis, lights);
+        assert!(
+            close(u_pair[k], u, MOMENTS_REL_TOL),
+            "pair lane {k}: {:?} vs {u:?}",
+            u_pair[k]
         );
     }
     out.iter().filter(|o| o[0] > 0.0).count()

@@ -413,6 +413,47 @@ where
     };
     let (i, g) = brdf.integral_gradient(wo_local, p, r);
     let (f, m) = vis.moments(p, r);
+    moments_contribution(frame, light, p, r, (i, g), (f, m))
+}
+
+/// [`light_moments`] and the same with nothing occluded (`f = 1`, `m = 0`), from one BRDF
+/// lookup: `(S, U)`, for a shadow ratio `S/U` (the harness's `rsl` method multiplies it
+/// into an exact unshadowed integral). `S` is bit-identical to [`light_moments`], `U` to
+/// [`light_moments`] with a visibility of `(1, 0)` everywhere (tested).
+#[inline]
+pub fn light_moments_pair<B, V>(
+    frame: &Frame,
+    wo_local: Vec3,
+    brdf: &B,
+    vis: &V,
+    light: &ShadeLight,
+) -> ([f32; 3], [f32; 3])
+where
+    B: BrdfIntegral + ?Sized,
+    V: SquareMoments + ?Sized,
+{
+    let Some((p, r)) = light.square_above_horizon(frame) else {
+        return ([0.0; 3], [0.0; 3]);
+    };
+    let (i, g) = brdf.integral_gradient(wo_local, p, r);
+    let (f, m) = vis.moments(p, r);
+    (
+        moments_contribution(frame, light, p, r, (i, g), (f, m)),
+        moments_contribution(frame, light, p, r, (i, g), (1.0, Vec2::ZERO)),
+    )
+}
+
+/// One light's contribution from the BRDF's `(I, g)` and the visibility's `(f, m)` over
+/// its square `(p, r)` ([`light_moments`]).
+#[inline(always)]
+fn moments_contribution(
+    frame: &Frame,
+    light: &ShadeLight,
+    p: Vec2,
+    r: f32,
+    (i, g): (f32, Vec2),
+    (f, m): (f32, Vec2),
+) -> [f32; 3] {
     // |R| in disk units: the square of half-diagonal r has side r·√2, so h² = r²/2.
     let area = 2.0 * r * r;
     let joint = i * f + area * g.dot(m);
@@ -468,6 +509,35 @@ where
     sum_lights(frame, wo, lights, |wo_local, l| {
         light_moments(frame, wo_local, brdf, vis, l)
     })
+}
+
+/// [`shade_moments`] and the same with nothing occluded, from one BRDF lookup per light
+/// ([`light_moments_pair`]): `(S, U)`.
+#[inline]
+pub fn shade_moments_pair<B, V>(
+    frame: &Frame,
+    wo: Vec3,
+    brdf: &B,
+    vis: &V,
+    lights: &[ShadeLight],
+) -> ([f32; 3], [f32; 3])
+where
+    B: BrdfIntegral + ?Sized,
+    V: SquareMoments + ?Sized,
+{
+    let wo_local = frame.to_local(wo);
+    if wo_local.z <= 0.0 {
+        return ([0.0; 3], [0.0; 3]);
+    }
+    let (mut s, mut u) = ([0.0f32; 3], [0.0f32; 3]);
+    for l in lights {
+        let (a, b) = light_moments_pair(frame, wo_local, brdf, vis, l);
+        for c in 0..3 {
+            s[c] += a[c];
+            u[c] += b[c];
+        }
+    }
+    (s, u)
 }
 
 /// Mean, standard deviation and third absolute central moment of a function over a region
@@ -864,6 +934,54 @@ mod tests {
             assert_eq!(a[ch].min(z[ch]), 0.0, "{a:?} {z:?}");
             assert!(a[ch].max(z[ch]) > 0.0, "{a:?} {z:?}");
         }
+    }
+
+    /// Every square fully visible: `(1, 0)`.
+    struct Free;
+    impl SquareMoments for Free {
+        fn moments(&self, _c: Vec2, _r: f32) -> (f32, Vec2) {
+            (1.0, Vec2::ZERO)
+        }
+    }
+
+    /// The pair kernel's `S` is [`shade_moments`] and its `U` is [`shade_moments`] seeing
+    /// everything, bit for bit, with and without radiance gradients, lights below the
+    /// horizon among them, a view below the horizon and a NaN view.
+    #[test]
+    fn moments_pair_is_the_kernel_with_and_without_visibility() {
+        let b = Linear {
+            a: 0.5,
+            g: Vec2::new(-0.4, 0.2),
+        };
+        let f = Frame::from_normal_tangent(Vec3::new(0.2, -0.1, 1.0), Vec3::X).unwrap();
+        let plain = Rsl::new(Vec3::new(0.3, -0.2, 1.0), Vec3::X, 0.1, [1.0, 2.0, 0.5]).unwrap();
+        let grad = [
+            Vec3::new(40.0, 5.0, 0.0),
+            Vec3::new(-8.0, 20.0, 3.0),
+            Vec3::ZERO,
+        ];
+        let tilted = plain.with_gradient(grad).unwrap();
+        let low = Rsl::new(Vec3::new(1.0, 0.2, 0.05), Vec3::Y, 0.3, [3.0; 3]).unwrap();
+        let down = Rsl::new(-Vec3::Z, Vec3::X, 0.05, [9.0; 3]).unwrap();
+        let lights: [ShadeLight; 4] = [&plain, &tilted, &low, &down].map(ShadeLight::from);
+        let bits = |v: [f32; 3]| v.map(f32::to_bits);
+        let views = [
+            Vec3::Z,
+            Vec3::new(0.5, 0.3, 0.8).normalize(),
+            -Vec3::Z,
+            Vec3::new(f32::NAN, 0.0, 1.0),
+        ];
+        for wo in views {
+            let (s, u) = shade_moments_pair(&f, wo, &b, &RightHalf, &lights);
+            assert_eq!(
+                bits(s),
+                bits(shade_moments(&f, wo, &b, &RightHalf, &lights))
+            );
+            assert_eq!(bits(u), bits(shade_moments(&f, wo, &b, &Free, &lights)));
+        }
+        // Occluded and free differ where the half-visible squares shade.
+        let (s, u) = shade_moments_pair(&f, Vec3::Z, &b, &RightHalf, &lights);
+        assert!((0..3).all(|c| s[c] < u[c]), "{s:?} {u:?}");
     }
 
     /// The GPU tables have the documented layout: header offsets that match the word

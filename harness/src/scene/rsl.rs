@@ -125,8 +125,9 @@ fn env_tables(scene: &Scene, specular: &BTreeMap<SpecKey, BrdfSat>) -> Option<En
     Some(EnvTables::build(env, &exponents))
 }
 
-/// The visibility moment tables of a point that sees everything, at `side`² (the `U` of
-/// the shadow ratio).
+/// The visibility moment tables of a point that sees everything, at `o.vis_side`²: the
+/// wgpu path's `U` of the shadow ratio (the CPU paths take `(f, m) = (1, 0)` exactly, in
+/// the pair kernels).
 pub fn free_moments(o: &Options) -> Result<VisMoments, String> {
     let mut cov = vec![0.0f32; o.vis_side * o.vis_side];
     coverage_into_depth(&[], o.vis_side, Outside::Visible, o.vis_depth, &mut cov)
@@ -283,7 +284,6 @@ pub fn choose_k(scene: &Scene, o: &Options, target: f64) -> Result<KChoice, Stri
         specular,
         unshadowed,
     } = build_many(scene, o, &ks)?;
-    let free = free_moments(o)?;
     let mut cov = vec![0.0f32; o.vis_side * o.vis_side];
     let points = super::probe_points(scene);
     let probes: Vec<_> = points
@@ -303,7 +303,7 @@ pub fn choose_k(scene: &Scene, o: &Options, target: f64) -> Result<KChoice, Stri
         images.push(
             probes
                 .iter()
-                .map(|(p, (frame, m))| shade_with(scene, &b, p, frame, m, &free))
+                .map(|(p, (frame, m))| shade_with(scene, &b, p, frame, m))
                 .collect::<Vec<Rgb>>(),
         );
         order.push(k);
@@ -317,13 +317,10 @@ pub fn choose_k(scene: &Scene, o: &Options, target: f64) -> Result<KChoice, Stri
     // The probes shaded with the chosen K's lights and the maps of `os`.
     let shaded = |os: &Options| -> Vec<Rgb> {
         let mut cov = vec![0.0f32; os.vis_side * os.vis_side];
-        let Ok(free) = free_moments(os) else {
-            return vec![[0.0; 3]; points.len()];
-        };
         points
             .iter()
             .map(|p| match point_moments(scene, os, p, &mut cov) {
-                Some((frame, m)) => shade_with(scene, &b, p, &frame, &m, &free),
+                Some((frame, m)) => shade_with(scene, &b, p, &frame, &m),
                 None => [0.0; 3],
             })
             .collect()
@@ -361,7 +358,6 @@ pub fn choose_k(scene: &Scene, o: &Options, target: f64) -> Result<KChoice, Stri
         ..*o
     };
     let mut cov = vec![0.0f32; vis_side * vis_side];
-    let free = free_moments(&os)?;
     let probes: Vec<_> = points
         .iter()
         .filter_map(|p| point_moments(scene, &os, p, &mut cov).map(|t| (p, t)))
@@ -383,7 +379,7 @@ pub fn choose_k(scene: &Scene, o: &Options, target: f64) -> Result<KChoice, Stri
         face_images.push(
             probes
                 .iter()
-                .map(|(p, (frame, m))| shade_with(scene, &b, p, frame, m, &free))
+                .map(|(p, (frame, m))| shade_with(scene, &b, p, frame, m))
                 .collect::<Vec<Rgb>>(),
         );
     }
@@ -567,19 +563,18 @@ fn combine(mat: &Material, d: Rgb, parts: impl IntoIterator<Item = (Rgb, Rgb)>) 
     out
 }
 
-/// The reflected radiance at a surface point (`free` from [`free_moments`] at `o`).
+/// The reflected radiance at a surface point.
 pub fn shade_point(
     scene: &Scene,
     b: &Built,
     o: &Options,
     p: &ShadingPoint,
     cov: &mut [f32],
-    free: &VisMoments,
 ) -> Rgb {
     let Some((frame, moments)) = point_moments(scene, o, p, cov) else {
         return [0.0; 3];
     };
-    shade_with(scene, b, p, &frame, &moments, free)
+    shade_with(scene, b, p, &frame, &moments)
 }
 
 /// [`shade_point`] with the point's frame and moment tables already built.
@@ -589,18 +584,20 @@ fn shade_with(
     p: &ShadingPoint,
     frame: &Frame,
     moments: &VisMoments,
-    free: &VisMoments,
 ) -> Rgb {
     let wo = p.wo.as_vec3();
     let mat = &scene.materials[p.material];
     let part = |key: Option<SpecKey>, sat: &BrdfSat| {
-        let s = shade::shade_moments(frame, wo, sat, moments, &b.lights);
-        let Some(t) = &b.unshadowed else {
-            return part_value(s, None, None);
-        };
-        let x = exact_part(t, key, p);
-        let u = x.map(|_| shade::shade_moments(frame, wo, sat, free, &b.lights));
-        part_value(s, u, x)
+        let x = b.unshadowed.as_ref().and_then(|t| exact_part(t, key, p));
+        if x.is_none() {
+            return part_value(
+                shade::shade_moments(frame, wo, sat, moments, &b.lights),
+                None,
+                None,
+            );
+        }
+        let (s, u) = shade::shade_moments_pair(frame, wo, sat, moments, &b.lights);
+        part_value(s, Some(u), x)
     };
     let d = part(None, &b.lambert);
     let parts = specular_parts(mat).filter_map(|(key, scale)| {
@@ -611,10 +608,10 @@ fn shade_with(
 }
 
 /// A kernel run over a set of points with one BRDF SAT: `None` the Lambert SAT, `Some(key)`
-/// a specular part's; `sel` indexes the caller's points; with `free`, every point seeing
-/// everything ([`free_moments`]); one integral per selected point.
+/// a specular part's; `sel` indexes the caller's points; one `(S, U)` per selected point,
+/// `U` the same seeing everything when `pair` is set (zeros otherwise).
 type PartBatch<'a> =
-    dyn FnMut(Option<SpecKey>, &[usize], bool) -> Result<Vec<[f32; 3]>, String> + 'a;
+    dyn FnMut(Option<SpecKey>, &[usize], bool) -> Result<Vec<([f32; 3], [f32; 3])>, String> + 'a;
 
 /// The radiance of points shaded part by part, the batched twin of [`shade_with`]:
 /// `batch` shades all `points` with the Lambert SAT, then, per specular part of
@@ -629,24 +626,19 @@ fn shade_by_part(
 ) -> Result<Vec<Rgb>, String> {
     // One part over the points `sel`: the kernel's values through the ratio.
     let mut part = |key: Option<SpecKey>, sel: &[usize]| -> Result<Vec<Rgb>, String> {
-        let s = batch(key, sel, false)?;
-        let Some(t) = &built.unshadowed else {
-            return Ok(s.into_iter().map(|v| part_value(v, None, None)).collect());
+        let x: Vec<Option<(Rgb, f64)>> = match &built.unshadowed {
+            Some(t) => sel
+                .iter()
+                .map(|&q| exact_part(t, key, &points[q]))
+                .collect(),
+            None => vec![None; sel.len()],
         };
-        let x: Vec<Option<(Rgb, f64)>> = sel
-            .iter()
-            .map(|&q| exact_part(t, key, &points[q]))
-            .collect();
-        let with: Vec<usize> = (0..sel.len()).filter(|&i| x[i].is_some()).collect();
-        let sub: Vec<usize> = with.iter().map(|&i| sel[i]).collect();
-        let mut u: Vec<Option<[f32; 3]>> = vec![None; sel.len()];
-        if !sub.is_empty() {
-            for (&i, v) in with.iter().zip(batch(key, &sub, true)?) {
-                u[i] = Some(v);
-            }
-        }
-        Ok((0..sel.len())
-            .map(|i| part_value(s[i], u[i], x[i]))
+        let pair = x.iter().any(Option::is_some);
+        let su = batch(key, sel, pair)?;
+        Ok(su
+            .into_iter()
+            .zip(x)
+            .map(|((s, u), x)| part_value(s, x.is_some().then_some(u), x))
             .collect())
     };
     let all: Vec<usize> = (0..points.len()).collect();
@@ -695,7 +687,9 @@ pub fn render_built_simd(
 ) -> Result<Image, String> {
     use rayon::prelude::*;
     use steradian_core::rsl::shade::gpu::iso_views;
-    use steradian_simd::rsl::shade::{IsoBrdfTables, MomentsInput, shade_moments_batch};
+    use steradian_simd::rsl::shade::{
+        IsoBrdfTables, MomentsInput, shade_moments_batch, shade_moments_pair_batch,
+    };
 
     fn iso(sat: &BrdfSat) -> Result<Vec<steradian_core::rsl::sat::SatView<'_>>, String> {
         iso_views(sat).ok_or_else(|| "the SIMD kernel takes isotropic BRDF SATs".to_string())
@@ -710,7 +704,6 @@ pub fn render_built_simd(
         tables: &lambert_views,
         s_max: built.lambert.s_max(),
     };
-    let free = free_moments(o)?;
     let cam = scene.camera;
     let (w, h) = (cam.width as usize, cam.height as usize);
     let rows: Vec<Result<Vec<Rgb>, String>> = (0..h)
@@ -731,7 +724,7 @@ pub fn render_built_simd(
                 }
             }
             let points: Vec<ShadingPoint> = pts.iter().map(|p| p.1).collect();
-            let mut batch = |key: Option<SpecKey>, sel: &[usize], see_all: bool| {
+            let mut batch = |key: Option<SpecKey>, sel: &[usize], pair: bool| {
                 let tables = match key {
                     None => lambert,
                     Some(k) => {
@@ -747,16 +740,18 @@ pub fn render_built_simd(
                     .map(|&q| MomentsInput {
                         frame: pts[q].2,
                         wo: pts[q].1.wo.as_vec3(),
-                        vis: if see_all {
-                            free.view()
-                        } else {
-                            pts[q].3.view()
-                        },
+                        vis: pts[q].3.view(),
                     })
                     .collect();
                 let mut out = vec![[0.0f32; 3]; sel.len()];
-                if shade_moments_batch(&input, &tables, &built.lights, &mut out) {
-                    Ok(out)
+                let mut free = vec![[0.0f32; 3]; sel.len()];
+                let ok = if pair {
+                    shade_moments_pair_batch(&input, &tables, &built.lights, &mut out, &mut free)
+                } else {
+                    shade_moments_batch(&input, &tables, &built.lights, &mut out)
+                };
+                if ok {
+                    Ok(out.into_iter().zip(free).collect())
                 } else {
                     Err("visibility tables of different sizes".to_string())
                 }
@@ -791,10 +786,9 @@ pub fn render_built(
     o: &Options,
     bar: &ProgressBar,
 ) -> Result<Image, String> {
-    let free = free_moments(o)?;
     let new_cov = || vec![0.0f32; o.vis_side * o.vis_side];
     let (img, _) = render_centres(scene, bar, new_cov, |cov, p| {
-        shade_point(scene, built, o, p, cov, &free)
+        shade_point(scene, built, o, p, cov)
     });
     Ok(img)
 }
@@ -860,25 +854,32 @@ pub fn render_built_gpu(
                 ms.push(m);
             }
         }
-        let mut batch = |key: Option<SpecKey>, sel: &[usize], see_all: bool| {
+        // With `pair`, a second dispatch with every point seeing everything (the WGSL
+        // kernel has no pair twin; the free table's moments are `(1, 0)` to rounding).
+        let mut batch = |key: Option<SpecKey>, sel: &[usize], pair: bool| {
             let sat = match key {
                 None => &built.lambert,
                 Some(k) => &built.specular[&k],
             };
             let sub_pts: Vec<ShadePoint> = sel.iter().map(|&q| pts[q].clone()).collect();
-            let sub_ms: Vec<&VisMoments> = sel
-                .iter()
-                .map(|&q| if see_all { &free } else { &ms[q] })
-                .collect();
-            shade_moments_gpu_at(
-                gpu,
-                &sub_pts,
-                sat,
-                &sub_ms,
-                &built.lights,
-                GPU_MOMENTS_MAX_TABLE_BYTES,
-            )
-            .map_err(|e| e.to_string())
+            let mut run = |ms: Vec<&VisMoments>| {
+                shade_moments_gpu_at(
+                    gpu,
+                    &sub_pts,
+                    sat,
+                    &ms,
+                    &built.lights,
+                    GPU_MOMENTS_MAX_TABLE_BYTES,
+                )
+                .map_err(|e| e.to_string())
+            };
+            let s = run(sel.iter().map(|&q| &ms[q]).collect())?;
+            let u = if pair {
+                run(vec![&free; sel.len()])?
+            } else {
+                vec![[0.0; 3]; sel.len()]
+            };
+            Ok(s.into_iter().zip(u).collect())
         };
         let shaded = shade_by_part(scene, built, &points, &mut batch)?;
         for (&(k, _), v) in px.iter().zip(shaded) {

@@ -693,6 +693,71 @@ pub fn shade_moments_x8(
     brdf: &IsoBrdfTables<'_>,
     lights: &[ShadeLight],
 ) -> Option<[[f32; 3]; 8]> {
+    moments_x8::<false>(points, brdf, lights).map(|(s, _)| s)
+}
+
+/// [`shade_moments_x8`] and the same with nothing occluded, from one BRDF lookup per light
+/// (`steradian_core::rsl::shade::shade_moments_pair`): `(S, U)` per lane.
+pub fn shade_moments_pair_x8(
+    points: &[MomentsInput<'_>; 8],
+    brdf: &IsoBrdfTables<'_>,
+    lights: &[ShadeLight],
+) -> Option<([[f32; 3]; 8], [[f32; 3]; 8])> {
+    moments_x8::<true>(points, brdf, lights)
+}
+
+/// One light's contribution per lane from the BRDF's `(I, g)` and the visibility's
+/// `(f, m)` (`steradian_core::rsl::shade::light_moments`, lane-wise).
+#[inline(always)]
+fn moments_contribution_x8(
+    lanes: &PointLanes,
+    l: &ShadeLight,
+    (px, py, r): (f32x8, f32x8, f32),
+    (i, g): (f32x8, [f32x8; 2]),
+    (f, m): (f32x8, [f32x8; 2]),
+) -> [f32x8; 3] {
+    let area = 2.0 * r * r;
+    let joint = i * f + f32x8::splat(area) * (g[0] * m[0] + g[1] * m[1]);
+    let joint = clamp_keep_nan(joint, i) * f32x8::splat(l.inv_solid_angle());
+    let e = l.energy();
+    let mut out: [f32x8; 3] = core::array::from_fn(|c| f32x8::splat(e[c]) * joint);
+    let grad = l.gradient();
+    if grad != [Vec3::ZERO; 3] {
+        let cf =
+            f32x8::splat(area) * f * f32x8::splat(r) * f32x8::splat(r) * f32x8::splat(1.0 / 6.0);
+        let w = [i * m[0] + cf * g[0], i * m[1] + cf * g[1]];
+        // `hemisphere::unmap_jacobian`, lane-wise.
+        let r2 = px * px + py * py;
+        let lim = f32x8::splat(2.0 - 1.0 / 4096.0);
+        let r2 = sel(r2.simd_gt(lim), lim, r2);
+        let sq = (f32x8::splat(2.0) - r2).sqrt();
+        let inv = f32x8::ONE / sq;
+        let uv = px * py * inv;
+        let two = f32x8::splat(2.0);
+        let ju = [sq - px * px * inv, -uv, -(two * px)];
+        let jv = [-uv, sq - py * py * inv, -(two * py)];
+        let loc: [f32x8; 3] = core::array::from_fn(|a| ju[a] * w[0] + jv[a] * w[1]);
+        // Frame::to_world: t·x + b·y + n·z.
+        let fr = &lanes.fr;
+        let u: [f32x8; 3] =
+            core::array::from_fn(|c| fr[0][c] * loc[0] + fr[1][c] * loc[1] + fr[2][c] * loc[2]);
+        for (o, gc) in out.iter_mut().zip(&grad) {
+            let d =
+                f32x8::splat(gc.x) * u[0] + f32x8::splat(gc.y) * u[1] + f32x8::splat(gc.z) * u[2];
+            *o = clamp_keep_nan(*o + d, f32x8::splat(f32::INFINITY));
+        }
+    }
+    out
+}
+
+/// The moments kernel for 8 points; with `PAIR`, also the same with nothing occluded
+/// (`f = 1`, `m = 0`; otherwise the second result is zeros).
+#[inline(always)]
+fn moments_x8<const PAIR: bool>(
+    points: &[MomentsInput<'_>; 8],
+    brdf: &IsoBrdfTables<'_>,
+    lights: &[ShadeLight],
+) -> Option<([[f32; 3]; 8], [[f32; 3]; 8])> {
     let tabs = brdf.tables;
     let (bw, bh) = brdf_size(brdf)?;
     let n = points[0].vis.side();
@@ -703,6 +768,7 @@ pub fn shade_moments_x8(
     let vis: [VisMomentsView<'_>; 8] = points.map(|p| p.vis);
     let half_b = 0.5 * bw as f32;
     let mut acc = [f32x8::ZERO; 3];
+    let mut acc_free = [f32x8::ZERO; 3];
     for l in lights {
         let r = l.half_diagonal();
         let (px, py, live) = lanes.square(l.centre(), f32x8::splat(r));
@@ -712,48 +778,25 @@ pub fn shade_moments_x8(
         let centre = lanes.brdf_centre(px, py, f32x8::splat(half_b));
         let h = steradian_core::rsl::sat::square_half_side(r) * half_b;
         let (i, g) = brdf_gradient(&lanes, tabs, centre, h, half_b, bw, bh);
-        let (f, m) = vis_moments_lanes(&vis, n, px, py, r);
-        // `shade::light_moments`, lane-wise.
-        let area = 2.0 * r * r;
-        let joint = i * f + f32x8::splat(area) * (g[0] * m[0] + g[1] * m[1]);
-        let joint = clamp_keep_nan(joint, i) * f32x8::splat(l.inv_solid_angle());
-        let e = l.energy();
-        let mut out: [f32x8; 3] = core::array::from_fn(|c| f32x8::splat(e[c]) * joint);
-        let grad = l.gradient();
-        if grad != [Vec3::ZERO; 3] {
-            let cf = f32x8::splat(area)
-                * f
-                * f32x8::splat(r)
-                * f32x8::splat(r)
-                * f32x8::splat(1.0 / 6.0);
-            let w = [i * m[0] + cf * g[0], i * m[1] + cf * g[1]];
-            // `hemisphere::unmap_jacobian`, lane-wise.
-            let r2 = px * px + py * py;
-            let lim = f32x8::splat(2.0 - 1.0 / 4096.0);
-            let r2 = sel(r2.simd_gt(lim), lim, r2);
-            let sq = (f32x8::splat(2.0) - r2).sqrt();
-            let inv = f32x8::ONE / sq;
-            let uv = px * py * inv;
-            let two = f32x8::splat(2.0);
-            let ju = [sq - px * px * inv, -uv, -(two * px)];
-            let jv = [-uv, sq - py * py * inv, -(two * py)];
-            let loc: [f32x8; 3] = core::array::from_fn(|a| ju[a] * w[0] + jv[a] * w[1]);
-            // Frame::to_world: t·x + b·y + n·z.
-            let fr = &lanes.fr;
-            let u: [f32x8; 3] =
-                core::array::from_fn(|c| fr[0][c] * loc[0] + fr[1][c] * loc[1] + fr[2][c] * loc[2]);
-            for (o, gc) in out.iter_mut().zip(&grad) {
-                let d = f32x8::splat(gc.x) * u[0]
-                    + f32x8::splat(gc.y) * u[1]
-                    + f32x8::splat(gc.z) * u[2];
-                *o = clamp_keep_nan(*o + d, f32x8::splat(f32::INFINITY));
-            }
-        }
+        let fm = vis_moments_lanes(&vis, n, px, py, r);
+        let out = moments_contribution_x8(&lanes, l, (px, py, r), (i, g), fm);
         for (a, o) in acc.iter_mut().zip(out) {
             *a += sel(live, o, f32x8::ZERO) + lanes.nan;
         }
+        if PAIR {
+            let free = (f32x8::ONE, [f32x8::ZERO; 2]);
+            let out = moments_contribution_x8(&lanes, l, (px, py, r), (i, g), free);
+            for (a, o) in acc_free.iter_mut().zip(out) {
+                *a += sel(live, o, f32x8::ZERO) + lanes.nan;
+            }
+        }
     }
-    Some(lanes.finish(acc))
+    let free = if PAIR {
+        lanes.finish(acc_free)
+    } else {
+        [[0.0; 3]; 8]
+    };
+    Some((lanes.finish(acc), free))
 }
 
 /// Shades every point with [`shade_moments_x8`] (`out[i]` for `points[i]`), 8 at a time;
@@ -767,6 +810,36 @@ pub fn shade_moments_batch(
     out: &mut [[f32; 3]],
 ) -> bool {
     by_eight(points, out, |g| shade_moments_x8(g, brdf, lights))
+}
+
+/// [`shade_moments_batch`] with [`shade_moments_pair_x8`]: `out[i]` and `free[i]` for
+/// `points[i]`; `false` as [`shade_moments_batch`] (or when `free`'s length differs).
+pub fn shade_moments_pair_batch(
+    points: &[MomentsInput<'_>],
+    brdf: &IsoBrdfTables<'_>,
+    lights: &[ShadeLight],
+    out: &mut [[f32; 3]],
+    free: &mut [[f32; 3]],
+) -> bool {
+    if free.len() != points.len() || out.len() != points.len() {
+        return false;
+    }
+    let Some(last) = points.last() else {
+        return true;
+    };
+    for ((group, o), u) in points
+        .chunks(8)
+        .zip(out.chunks_mut(8))
+        .zip(free.chunks_mut(8))
+    {
+        let g: [MomentsInput<'_>; 8] = core::array::from_fn(|j| *group.get(j).unwrap_or(last));
+        let Some((s, f)) = shade_moments_pair_x8(&g, brdf, lights) else {
+            return false;
+        };
+        o.copy_from_slice(&s[..o.len()]);
+        u.copy_from_slice(&f[..u.len()]);
+    }
+    true
 }
 
 /// `out[i]` = lane `i mod 8` of `x8` on the group of eight points holding `points[i]` (the
