@@ -696,13 +696,16 @@ pub fn shade_moments_x8(
     moments_x8::<false>(points, brdf, lights).map(|(s, _)| s)
 }
 
+/// RGB of eight lanes: the shadowed `S` and the unshadowed `U` of [`shade_moments_pair_x8`].
+pub type PairX8 = ([[f32; 3]; 8], [[f32; 3]; 8]);
+
 /// [`shade_moments_x8`] and the same with nothing occluded, from one BRDF lookup per light
 /// (`steradian_core::rsl::shade::shade_moments_pair`): `(S, U)` per lane.
 pub fn shade_moments_pair_x8(
     points: &[MomentsInput<'_>; 8],
     brdf: &IsoBrdfTables<'_>,
     lights: &[ShadeLight],
-) -> Option<([[f32; 3]; 8], [[f32; 3]; 8])> {
+) -> Option<PairX8> {
     moments_x8::<true>(points, brdf, lights)
 }
 
@@ -757,7 +760,7 @@ fn moments_x8<const PAIR: bool>(
     points: &[MomentsInput<'_>; 8],
     brdf: &IsoBrdfTables<'_>,
     lights: &[ShadeLight],
-) -> Option<([[f32; 3]; 8], [[f32; 3]; 8])> {
+) -> Option<PairX8> {
     let tabs = brdf.tables;
     let (bw, bh) = brdf_size(brdf)?;
     let n = points[0].vis.side();
