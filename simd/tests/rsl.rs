@@ -470,7 +470,12 @@ fn check_moments(s: &Setup, pts: &[(Frame, Vec3); 8], lights: &[ShadeLight]) -> 
     });
     let out = shade_moments_x8(&input, &tables, lights).expect("same sizes");
     // The pair kernel: its `S` is the kernel's bit for bit, its `U` the scalar pair's.
-    let (s_pair, u_pair) = shade_moments_pair_x8(&input, &tables, lights).expect("same sizes");
+    let (s_pair, u_pair) =
+        shade_moments_pair_x8(&input, &tables, lights, None).expect("same sizes");
+    // With a base: the tables of the next lane (U under another point's visibility).
+    let base: [_; 8] = core::array::from_fn(|k| s.moments[(k + 1) % 8].view());
+    let (s_based, u_based) =
+        shade_moments_pair_x8(&input, &tables, lights, Some(&base)).expect("same sizes");
     let bits = |v: [f32; 3]| v.map(f32::to_bits);
     for (k, p) in input.iter().enumerate() {
         let want = core_shade::shade_moments(&p.frame, p.wo, &s.sat, &p.vis, lights);
@@ -480,11 +485,26 @@ fn check_moments(s: &Setup, pts: &[(Frame, Vec3); 8], lights: &[ShadeLight]) -> 
             out[k]
         );
         assert_eq!(bits(s_pair[k]), bits(out[k]), "pair lane {k}");
-        let (_, u) = core_shade::shade_moments_pair(&p.frame, p.wo, &s.sat, &p.vis, lights);
+        let (_, u) = core_shade::shade_moments_pair(
+            &p.frame,
+            p.wo,
+            &s.sat,
+            &p.vis,
+            &core_shade::Unoccluded,
+            lights,
+        );
         assert!(
             close(u_pair[k], u, MOMENTS_REL_TOL),
             "pair lane {k}: {:?} vs {u:?}",
             u_pair[k]
+        );
+        assert_eq!(bits(s_based[k]), bits(out[k]), "based pair lane {k}");
+        let (_, ub) =
+            core_shade::shade_moments_pair(&p.frame, p.wo, &s.sat, &p.vis, &base[k], lights);
+        assert!(
+            close(u_based[k], ub, MOMENTS_REL_TOL),
+            "based pair lane {k}: {:?} vs {ub:?}",
+            u_based[k]
         );
     }
     out.iter().filter(|o| o[0] > 0.0).count()

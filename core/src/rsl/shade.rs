@@ -178,6 +178,14 @@ impl SquareVisibility for Unoccluded {
     }
 }
 
+impl SquareMoments for Unoccluded {
+    /// `(1, 0)`: the whole square, whose first moment about its centre is zero.
+    #[inline]
+    fn moments(&self, _centre: Vec2, _half_diagonal: f32) -> (f32, Vec2) {
+        (1.0, Vec2::ZERO)
+    }
+}
+
 /// Which VDT estimate of the visible fraction to use ([`crate::rsl::vdt`]).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum VdtQuery {
@@ -416,30 +424,31 @@ where
     moments_contribution(frame, light, p, r, (i, g), (f, m))
 }
 
-/// [`light_moments`] and the same with nothing occluded (`f = 1`, `m = 0`), from one BRDF
-/// lookup: `(S, U)`, for a shadow ratio `S/U` (the harness's `rsl` method multiplies it
-/// into an exact unshadowed integral). `S` is bit-identical to [`light_moments`], `U` to
-/// [`light_moments`] with a visibility of `(1, 0)` everywhere (tested).
+/// [`light_moments`] with two visibilities from one BRDF lookup: `(S, U)` with `S` under
+/// `vis` and `U` under `base` (typically fewer occluders: [`Unoccluded`] for none), for a
+/// shadow ratio `S/U` (the harness's `rsl` method multiplies it into an exact integral
+/// under `base`). Each is bit-identical to [`light_moments`] with its visibility (tested).
 #[inline]
-pub fn light_moments_pair<B, V>(
+pub fn light_moments_pair<B, V, W>(
     frame: &Frame,
     wo_local: Vec3,
     brdf: &B,
     vis: &V,
+    base: &W,
     light: &ShadeLight,
 ) -> ([f32; 3], [f32; 3])
 where
     B: BrdfIntegral + ?Sized,
     V: SquareMoments + ?Sized,
+    W: SquareMoments + ?Sized,
 {
     let Some((p, r)) = light.square_above_horizon(frame) else {
         return ([0.0; 3], [0.0; 3]);
     };
     let (i, g) = brdf.integral_gradient(wo_local, p, r);
-    let (f, m) = vis.moments(p, r);
     (
-        moments_contribution(frame, light, p, r, (i, g), (f, m)),
-        moments_contribution(frame, light, p, r, (i, g), (1.0, Vec2::ZERO)),
+        moments_contribution(frame, light, p, r, (i, g), vis.moments(p, r)),
+        moments_contribution(frame, light, p, r, (i, g), base.moments(p, r)),
     )
 }
 
@@ -511,19 +520,21 @@ where
     })
 }
 
-/// [`shade_moments`] and the same with nothing occluded, from one BRDF lookup per light
-/// ([`light_moments_pair`]): `(S, U)`.
+/// [`shade_moments`] under two visibilities, `vis` and `base`, from one BRDF lookup per
+/// light ([`light_moments_pair`]): `(S, U)`.
 #[inline]
-pub fn shade_moments_pair<B, V>(
+pub fn shade_moments_pair<B, V, W>(
     frame: &Frame,
     wo: Vec3,
     brdf: &B,
     vis: &V,
+    base: &W,
     lights: &[ShadeLight],
 ) -> ([f32; 3], [f32; 3])
 where
     B: BrdfIntegral + ?Sized,
     V: SquareMoments + ?Sized,
+    W: SquareMoments + ?Sized,
 {
     let wo_local = frame.to_local(wo);
     if wo_local.z <= 0.0 {
@@ -531,7 +542,7 @@ where
     }
     let (mut s, mut u) = ([0.0f32; 3], [0.0f32; 3]);
     for l in lights {
-        let (a, b) = light_moments_pair(frame, wo_local, brdf, vis, l);
+        let (a, b) = light_moments_pair(frame, wo_local, brdf, vis, base, l);
         for c in 0..3 {
             s[c] += a[c];
             u[c] += b[c];
@@ -936,17 +947,10 @@ mod tests {
         }
     }
 
-    /// Every square fully visible: `(1, 0)`.
-    struct Free;
-    impl SquareMoments for Free {
-        fn moments(&self, _c: Vec2, _r: f32) -> (f32, Vec2) {
-            (1.0, Vec2::ZERO)
-        }
-    }
-
-    /// The pair kernel's `S` is [`shade_moments`] and its `U` is [`shade_moments`] seeing
-    /// everything, bit for bit, with and without radiance gradients, lights below the
-    /// horizon among them, a view below the horizon and a NaN view.
+    /// The pair kernel's `S` and `U` are [`shade_moments`] under each visibility, bit for
+    /// bit (with [`Unoccluded`] and with the same visibility as a base), with and without
+    /// radiance gradients, lights below the horizon among them, a view below the horizon
+    /// and a NaN view.
     #[test]
     fn moments_pair_is_the_kernel_with_and_without_visibility() {
         let b = Linear {
@@ -972,15 +976,16 @@ mod tests {
             Vec3::new(f32::NAN, 0.0, 1.0),
         ];
         for wo in views {
-            let (s, u) = shade_moments_pair(&f, wo, &b, &RightHalf, &lights);
-            assert_eq!(
-                bits(s),
-                bits(shade_moments(&f, wo, &b, &RightHalf, &lights))
-            );
-            assert_eq!(bits(u), bits(shade_moments(&f, wo, &b, &Free, &lights)));
+            let (s, u) = shade_moments_pair(&f, wo, &b, &RightHalf, &Unoccluded, &lights);
+            let want = shade_moments(&f, wo, &b, &RightHalf, &lights);
+            assert_eq!(bits(s), bits(want));
+            let free = shade_moments(&f, wo, &b, &Unoccluded, &lights);
+            assert_eq!(bits(u), bits(free));
+            let (s2, u2) = shade_moments_pair(&f, wo, &b, &RightHalf, &RightHalf, &lights);
+            assert_eq!((bits(s2), bits(u2)), (bits(want), bits(want)));
         }
         // Occluded and free differ where the half-visible squares shade.
-        let (s, u) = shade_moments_pair(&f, Vec3::Z, &b, &RightHalf, &lights);
+        let (s, u) = shade_moments_pair(&f, Vec3::Z, &b, &RightHalf, &Unoccluded, &lights);
         assert!((0..3).all(|c| s[c] < u[c]), "{s:?} {u:?}");
     }
 

@@ -25,13 +25,15 @@
 use std::collections::BTreeMap;
 use std::f32::consts::FRAC_PI_2;
 
+use glam::DVec3;
+
 use indicatif::ProgressBar;
 use steradian_core::frame::Frame;
 use steradian_core::lobe::brdf::{Ggx, Lambert, Phong};
 use steradian_core::lobe::cap::SphericalCap;
 use steradian_core::lobe::{Lafortune, LafortuneLobe};
 use steradian_core::rsl::brdf_sat::BrdfSat;
-use steradian_core::rsl::shade::{self, ShadeLight};
+use steradian_core::rsl::shade::{self, ShadeLight, Unoccluded};
 use steradian_core::rsl::vis_moments::VisMoments;
 use steradian_core::rsl::visibility::{Outside, coverage_into_depth, local_cap};
 
@@ -95,8 +97,8 @@ pub struct Built {
     pub lambert: BrdfSat,
     /// The specular SATs by [`SpecKey`].
     pub specular: BTreeMap<SpecKey, BrdfSat>,
-    /// The exact unshadowed integrals ([`Options::exact_unshadowed`]).
-    pub unshadowed: Option<EnvTables>,
+    /// The exact unshadowed integrals per [`PlaneSides`] ([`Options::exact_unshadowed`]).
+    pub unshadowed: Option<BTreeMap<PlaneSides, EnvTables>>,
 }
 
 /// Decomposes the environment and fits the SATs the materials need.
@@ -110,10 +112,14 @@ pub fn build(scene: &Scene, o: &Options) -> Result<Built, String> {
     })
 }
 
-/// The environment tables of [`Options::exact_unshadowed`]: the diffuse one and one per
-/// glossy lobe exponent of the specular parts (Phong, Lafortune; GGX keeps the squares'
-/// estimate).
-fn env_tables(scene: &Scene, specular: &BTreeMap<SpecKey, BrdfSat>) -> Option<EnvTables> {
+/// The environment tables of [`Options::exact_unshadowed`], per [`PlaneSides`] a shaded
+/// point can have ([`plane_signatures`]; the environment seen through the half-spaces its
+/// planes leave open): the diffuse one and one per glossy lobe exponent of the specular
+/// parts (Phong, Lafortune; GGX keeps the squares' estimate).
+fn env_tables(
+    scene: &Scene,
+    specular: &BTreeMap<SpecKey, BrdfSat>,
+) -> Option<BTreeMap<PlaneSides, EnvTables>> {
     let env = scene.environment.as_ref()?;
     let exponents: Vec<f64> = specular
         .keys()
@@ -122,7 +128,16 @@ fn env_tables(scene: &Scene, specular: &BTreeMap<SpecKey, BrdfSat>) -> Option<En
             SpecKey::Ggx(..) => None,
         })
         .collect();
-    Some(EnvTables::build(env, &exponents))
+    Some(
+        plane_signatures(scene)
+            .into_iter()
+            .map(|sides| {
+                let open = open_half_spaces(scene, &sides);
+                let t = EnvTables::build(env, &open, &exponents);
+                (sides, t)
+            })
+            .collect(),
+    )
 }
 
 /// The visibility moment tables of a point that sees everything, at `o.vis_side`²: the
@@ -182,8 +197,8 @@ pub struct BuiltMany {
     pub lambert: BrdfSat,
     /// The specular SATs by [`SpecKey`].
     pub specular: BTreeMap<SpecKey, BrdfSat>,
-    /// The exact unshadowed integrals ([`Options::exact_unshadowed`]).
-    pub unshadowed: Option<EnvTables>,
+    /// The exact unshadowed integrals per [`PlaneSides`] ([`Options::exact_unshadowed`]).
+    pub unshadowed: Option<BTreeMap<PlaneSides, EnvTables>>,
 }
 
 /// The environment (times its scale) decomposed into each of `ks` square lights, and the
@@ -288,7 +303,7 @@ pub fn choose_k(scene: &Scene, o: &Options, target: f64) -> Result<KChoice, Stri
     let points = super::probe_points(scene);
     let probes: Vec<_> = points
         .iter()
-        .filter_map(|p| point_moments(scene, o, p, &mut cov).map(|t| (p, t)))
+        .filter_map(|p| point_vis(scene, o, p, &mut cov).map(|t| (p, t)))
         .collect();
     // The probes shaded with each K's lights (the SATs shared).
     let mut b = Built {
@@ -303,7 +318,7 @@ pub fn choose_k(scene: &Scene, o: &Options, target: f64) -> Result<KChoice, Stri
         images.push(
             probes
                 .iter()
-                .map(|(p, (frame, m))| shade_with(scene, &b, p, frame, m))
+                .map(|(p, (frame, m, base))| shade_with(scene, &b, p, frame, m, base))
                 .collect::<Vec<Rgb>>(),
         );
         order.push(k);
@@ -319,8 +334,8 @@ pub fn choose_k(scene: &Scene, o: &Options, target: f64) -> Result<KChoice, Stri
         let mut cov = vec![0.0f32; os.vis_side * os.vis_side];
         points
             .iter()
-            .map(|p| match point_moments(scene, os, p, &mut cov) {
-                Some((frame, m)) => shade_with(scene, &b, p, &frame, &m),
+            .map(|p| match point_vis(scene, os, p, &mut cov) {
+                Some((frame, m, base)) => shade_with(scene, &b, p, &frame, &m, &base),
                 None => [0.0; 3],
             })
             .collect()
@@ -360,7 +375,7 @@ pub fn choose_k(scene: &Scene, o: &Options, target: f64) -> Result<KChoice, Stri
     let mut cov = vec![0.0f32; vis_side * vis_side];
     let probes: Vec<_> = points
         .iter()
-        .filter_map(|p| point_moments(scene, &os, p, &mut cov).map(|t| (p, t)))
+        .filter_map(|p| point_vis(scene, &os, p, &mut cov).map(|t| (p, t)))
         .collect();
     let faces: Vec<usize> = FACE_CANDIDATES
         .iter()
@@ -379,7 +394,7 @@ pub fn choose_k(scene: &Scene, o: &Options, target: f64) -> Result<KChoice, Stri
         face_images.push(
             probes
                 .iter()
-                .map(|(p, (frame, m))| shade_with(scene, &b, p, frame, m))
+                .map(|(p, (frame, m, base))| shade_with(scene, &b, p, frame, m, base))
                 .collect::<Vec<Rgb>>(),
         );
     }
@@ -397,6 +412,145 @@ pub fn choose_k(scene: &Scene, o: &Options, target: f64) -> Result<KChoice, Stri
     })
 }
 
+/// The planes a point is not on, each with the side it is on (`true`: the side its normal
+/// points to). A plane hides exactly the half of the directions that head toward it, so
+/// these sides alone say what the planes leave open: `v·ω > 0` with `v` the normal, or its
+/// opposite, per plane ([`open_half_spaces`]).
+pub type PlaneSides = Vec<(usize, bool)>;
+
+/// The planes `x` (on object `own`) is not on, with its side of each ([`PlaneSides`]; the
+/// same test as [`point_moments`]).
+pub fn plane_sides(scene: &Scene, x: DVec3, own: usize) -> PlaneSides {
+    let mut out = Vec::new();
+    for (id, obj) in scene.objects.iter().enumerate() {
+        if let (true, Shape::Plane { point, normal }) = (id != own, obj.shape) {
+            let s = normal.dot(x - point);
+            if s.abs() > 1e-6 * (1.0 + x.abs().max_element()) {
+                out.push((id, s > 0.0));
+            }
+        }
+    }
+    out
+}
+
+/// The unit vectors `v` of the half-spaces `v·ω > 0` that the planes of `sides` leave open.
+pub fn open_half_spaces(scene: &Scene, sides: &PlaneSides) -> Vec<DVec3> {
+    sides
+        .iter()
+        .filter_map(|&(id, up)| match scene.objects.get(id)?.shape {
+            Shape::Plane { normal, .. } => Some(if up { normal } else { -normal }),
+            Shape::Sphere { .. } => None,
+        })
+        .collect()
+}
+
+/// Every [`PlaneSides`] a shaded point of the scene can have: per surface, each plane
+/// it is not on with the side it lies on, or both sides for a sphere the plane cuts and a
+/// plane it crosses. At most 64 per surface (more planes cut it: the rest keep the
+/// squares' estimate).
+fn plane_signatures(scene: &Scene) -> Vec<PlaneSides> {
+    let planes: Vec<(usize, DVec3, DVec3)> = scene
+        .objects
+        .iter()
+        .enumerate()
+        .filter_map(|(id, o)| match o.shape {
+            Shape::Plane { point, normal } => Some((id, point, normal)),
+            Shape::Sphere { .. } => None,
+        })
+        .collect();
+    let mut all = std::collections::BTreeSet::new();
+    for (id, obj) in scene.objects.iter().enumerate() {
+        if !matches!(obj.kind, super::Kind::Surface(_)) {
+            continue;
+        }
+        let mut combos: Vec<PlaneSides> = vec![Vec::new()];
+        for &(pid, point, normal) in &planes {
+            if pid == id {
+                continue;
+            }
+            let sides: Vec<bool> = match obj.shape {
+                Shape::Sphere { center, radius } => {
+                    let d = normal.dot(center - point);
+                    if d.abs() >= radius {
+                        vec![d > 0.0]
+                    } else {
+                        vec![true, false]
+                    }
+                }
+                Shape::Plane {
+                    point: q,
+                    normal: m,
+                } => {
+                    if normal.dot(m).abs() >= 1.0 - 1e-12 {
+                        let d = normal.dot(q - point);
+                        if d.abs() <= 1e-6 * (1.0 + q.abs().max_element()) {
+                            continue;
+                        }
+                        vec![d > 0.0]
+                    } else {
+                        vec![true, false]
+                    }
+                }
+            };
+            if combos.len() * sides.len() > 64 {
+                continue;
+            }
+            combos = combos
+                .into_iter()
+                .flat_map(|c| {
+                    sides.iter().map(move |&up| {
+                        let mut c = c.clone();
+                        c.push((pid, up));
+                        c
+                    })
+                })
+                .collect();
+        }
+        all.extend(combos);
+    }
+    all.into_iter().collect()
+}
+
+/// What the shadow ratio's `U` is taken under at a point: the visibility of its planes
+/// alone, which its exact integral already holds ([`EnvTables`] of its [`PlaneSides`]).
+pub enum Base {
+    /// No plane occludes the point: nothing occluded (`(f, m) = (1, 0)`).
+    Free,
+    /// Only planes occlude it: its own tables (so `S = U`).
+    Same,
+    /// Planes and spheres occlude it: the moment tables of its planes alone.
+    Map(VisMoments),
+}
+
+/// The caps of the other spheres, then of the planes the point is not on (module docs).
+fn occluder_caps(
+    scene: &Scene,
+    p: &ShadingPoint,
+    frame: &Frame,
+) -> (Vec<SphericalCap>, Vec<SphericalCap>) {
+    let x = p.x;
+    let (mut spheres, mut planes) = (Vec::new(), Vec::new());
+    for (id, obj) in scene.objects.iter().enumerate() {
+        if id == p.object {
+            continue;
+        }
+        if let Shape::Sphere { center, radius } = obj.shape
+            && let Ok(c) = local_cap(x.as_vec3(), frame, center.as_vec3(), radius as f32)
+        {
+            spheres.push(c);
+        }
+    }
+    for (id, up) in plane_sides(scene, x, p.object) {
+        if let Shape::Plane { normal, .. } = scene.objects[id].shape {
+            let toward = if up { -normal } else { normal };
+            if let Ok(c) = SphericalCap::new(frame.to_local(toward.as_vec3()), FRAC_PI_2) {
+                planes.push(c);
+            }
+        }
+    }
+    (spheres, planes)
+}
+
 /// The visibility moment tables of a surface point (module docs), `None` where the point
 /// has no frame or its map cannot be built (it is then shaded black).
 pub fn point_moments(
@@ -406,33 +560,36 @@ pub fn point_moments(
     cov: &mut [f32],
 ) -> Option<(Frame, VisMoments)> {
     let frame = Frame::from_normal(p.n.as_vec3()).ok()?;
-    let x = p.x;
-    let mut caps = Vec::new();
-    for (id, obj) in scene.objects.iter().enumerate() {
-        if id == p.object {
-            continue;
-        }
-        match obj.shape {
-            Shape::Sphere { center, radius } => {
-                if let Ok(c) = local_cap(x.as_vec3(), &frame, center.as_vec3(), radius as f32) {
-                    caps.push(c);
-                }
-            }
-            Shape::Plane { point, normal } => {
-                let s = normal.dot(x - point);
-                if s.abs() <= 1e-6 * (1.0 + x.abs().max_element()) {
-                    continue;
-                }
-                let toward = -normal * s.signum();
-                if let Ok(c) = SphericalCap::new(frame.to_local(toward.as_vec3()), FRAC_PI_2) {
-                    caps.push(c);
-                }
-            }
-        }
-    }
+    let (mut caps, planes) = occluder_caps(scene, p, &frame);
+    caps.extend(planes);
     coverage_into_depth(&caps, o.vis_side, Outside::Visible, o.vis_depth, cov).ok()?;
     let moments = VisMoments::build_coverage(o.vis_side, cov).ok()?;
     Some((frame, moments))
+}
+
+/// [`point_moments`] with the point's [`Base`] (its planes' own map built where spheres
+/// occlude it too); [`Base::Free`] without the shadow ratio.
+pub fn point_vis(
+    scene: &Scene,
+    o: &Options,
+    p: &ShadingPoint,
+    cov: &mut [f32],
+) -> Option<(Frame, VisMoments, Base)> {
+    let frame = Frame::from_normal(p.n.as_vec3()).ok()?;
+    let (spheres, planes) = occluder_caps(scene, p, &frame);
+    let base = if !o.exact_unshadowed || planes.is_empty() {
+        Base::Free
+    } else if spheres.is_empty() {
+        Base::Same
+    } else {
+        coverage_into_depth(&planes, o.vis_side, Outside::Visible, o.vis_depth, cov).ok()?;
+        Base::Map(VisMoments::build_coverage(o.vis_side, cov).ok()?)
+    };
+    let mut caps = spheres;
+    caps.extend(planes);
+    coverage_into_depth(&caps, o.vis_side, Outside::Visible, o.vis_depth, cov).ok()?;
+    let moments = VisMoments::build_coverage(o.vis_side, cov).ok()?;
+    Some((frame, moments, base))
 }
 
 /// A specular BRDF the method fits one SAT for, with unit scale: modified Phong
@@ -571,24 +728,33 @@ pub fn shade_point(
     p: &ShadingPoint,
     cov: &mut [f32],
 ) -> Rgb {
-    let Some((frame, moments)) = point_moments(scene, o, p, cov) else {
+    let Some((frame, moments, base)) = point_vis(scene, o, p, cov) else {
         return [0.0; 3];
     };
-    shade_with(scene, b, p, &frame, &moments)
+    shade_with(scene, b, p, &frame, &moments, &base)
 }
 
-/// [`shade_point`] with the point's frame and moment tables already built.
+/// The exact-integral tables of a point's [`PlaneSides`], with the shadow ratio.
+fn tables_at<'a>(scene: &Scene, b: &'a Built, p: &ShadingPoint) -> Option<&'a EnvTables> {
+    b.unshadowed
+        .as_ref()?
+        .get(&plane_sides(scene, p.x, p.object))
+}
+
+/// [`shade_point`] with the point's frame, moment tables and [`Base`] already built.
 fn shade_with(
     scene: &Scene,
     b: &Built,
     p: &ShadingPoint,
     frame: &Frame,
     moments: &VisMoments,
+    base: &Base,
 ) -> Rgb {
     let wo = p.wo.as_vec3();
     let mat = &scene.materials[p.material];
+    let tables = tables_at(scene, b, p);
     let part = |key: Option<SpecKey>, sat: &BrdfSat| {
-        let x = b.unshadowed.as_ref().and_then(|t| exact_part(t, key, p));
+        let x = tables.and_then(|t| exact_part(t, key, p));
         if x.is_none() {
             return part_value(
                 shade::shade_moments(frame, wo, sat, moments, &b.lights),
@@ -596,7 +762,13 @@ fn shade_with(
                 None,
             );
         }
-        let (s, u) = shade::shade_moments_pair(frame, wo, sat, moments, &b.lights);
+        let (s, u) = match base {
+            Base::Free => {
+                shade::shade_moments_pair(frame, wo, sat, moments, &Unoccluded, &b.lights)
+            }
+            Base::Same => shade::shade_moments_pair(frame, wo, sat, moments, moments, &b.lights),
+            Base::Map(m) => shade::shade_moments_pair(frame, wo, sat, moments, m, &b.lights),
+        };
         part_value(s, Some(u), x)
     };
     let d = part(None, &b.lambert);
@@ -609,7 +781,7 @@ fn shade_with(
 
 /// A kernel run over a set of points with one BRDF SAT: `None` the Lambert SAT, `Some(key)`
 /// a specular part's; `sel` indexes the caller's points; one `(S, U)` per selected point,
-/// `U` the same seeing everything when `pair` is set (zeros otherwise).
+/// `U` under the point's [`Base`] when `pair` is set (zeros otherwise).
 type PartBatch<'a> =
     dyn FnMut(Option<SpecKey>, &[usize], bool) -> Result<Vec<([f32; 3], [f32; 3])>, String> + 'a;
 
@@ -626,13 +798,12 @@ fn shade_by_part(
 ) -> Result<Vec<Rgb>, String> {
     // One part over the points `sel`: the kernel's values through the ratio.
     let mut part = |key: Option<SpecKey>, sel: &[usize]| -> Result<Vec<Rgb>, String> {
-        let x: Vec<Option<(Rgb, f64)>> = match &built.unshadowed {
-            Some(t) => sel
-                .iter()
-                .map(|&q| exact_part(t, key, &points[q]))
-                .collect(),
-            None => vec![None; sel.len()],
-        };
+        let x: Vec<Option<(Rgb, f64)>> = sel
+            .iter()
+            .map(|&q| {
+                tables_at(scene, built, &points[q]).and_then(|t| exact_part(t, key, &points[q]))
+            })
+            .collect();
         let pair = x.iter().any(Option::is_some);
         let su = batch(key, sel, pair)?;
         Ok(su
@@ -717,8 +888,8 @@ pub fn render_built_simd(
                 match scene.see(&cam.centre_ray(i as u32, j as u32)) {
                     Seen::Radiance(l) => *px = l,
                     Seen::Surface(p) => {
-                        if let Some((frame, m)) = point_moments(scene, o, &p, &mut cov) {
-                            pts.push((i, p, frame, m));
+                        if let Some((frame, m, base)) = point_vis(scene, o, &p, &mut cov) {
+                            pts.push((i, p, frame, m, base));
                         }
                     }
                 }
@@ -746,7 +917,44 @@ pub fn render_built_simd(
                 let mut out = vec![[0.0f32; 3]; sel.len()];
                 let mut free = vec![[0.0f32; 3]; sel.len()];
                 let ok = if pair {
-                    shade_moments_pair_batch(&input, &tables, &built.lights, &mut out, &mut free)
+                    // Two runs: the points whose `U` sees everything, then those with a
+                    // base map (their planes' own, or their own tables).
+                    let based: Vec<usize> = (0..sel.len())
+                        .filter(|&k| !matches!(pts[sel[k]].4, Base::Free))
+                        .collect();
+                    let unbased: Vec<usize> = (0..sel.len())
+                        .filter(|&k| matches!(pts[sel[k]].4, Base::Free))
+                        .collect();
+                    let mut ok = true;
+                    for (group, with_base) in [(unbased, false), (based, true)] {
+                        if group.is_empty() {
+                            continue;
+                        }
+                        let inp: Vec<MomentsInput<'_>> = group.iter().map(|&k| input[k]).collect();
+                        let views: Vec<_> = group
+                            .iter()
+                            .map(|&k| match &pts[sel[k]].4 {
+                                Base::Map(m) => m.view(),
+                                _ => pts[sel[k]].3.view(),
+                            })
+                            .collect();
+                        let (mut o2, mut f2) =
+                            (vec![[0.0; 3]; group.len()], vec![[0.0; 3]; group.len()]);
+                        let b = with_base.then_some(views.as_slice());
+                        ok &= shade_moments_pair_batch(
+                            &inp,
+                            &tables,
+                            &built.lights,
+                            b,
+                            &mut o2,
+                            &mut f2,
+                        );
+                        for (j, &k) in group.iter().enumerate() {
+                            out[k] = o2[j];
+                            free[k] = f2[j];
+                        }
+                    }
+                    ok
                 } else {
                     shade_moments_batch(&input, &tables, &built.lights, &mut out)
                 };
@@ -757,7 +965,7 @@ pub fn render_built_simd(
                 }
             };
             let shaded = shade_by_part(scene, built, &points, &mut batch)?;
-            for ((i, _, _, _), v) in pts.iter().zip(shaded) {
+            for ((i, _, _, _, _), v) in pts.iter().zip(shaded) {
                 row[*i] = v;
             }
             bar.inc(1);
@@ -829,11 +1037,11 @@ pub fn render_built_gpu(
         }
     }
     for chunk in queue.chunks(GPU_BATCH) {
-        let tables: Vec<Option<(Frame, VisMoments)>> = chunk
+        let tables: Vec<Option<(Frame, VisMoments, Base)>> = chunk
             .par_iter()
             .map_init(
                 || vec![0.0f32; o.vis_side * o.vis_side],
-                |cov, (_, p)| point_moments(scene, o, p, cov),
+                |cov, (_, p)| point_vis(scene, o, p, cov),
             )
             .collect();
         // The shaded points of the batch (those with tables) with their pixel.
@@ -841,8 +1049,10 @@ pub fn render_built_gpu(
         let mut px = Vec::new();
         let mut pts = Vec::new();
         let mut ms = Vec::new();
+        let mut bases = Vec::new();
         for ((k, p), t) in chunk.iter().zip(tables) {
-            if let Some((frame, m)) = t {
+            if let Some((frame, m, base)) = t {
+                bases.push(base);
                 points.push(*p);
                 px.push((*k, p.material));
                 pts.push(ShadePoint {
@@ -854,8 +1064,8 @@ pub fn render_built_gpu(
                 ms.push(m);
             }
         }
-        // With `pair`, a second dispatch with every point seeing everything (the WGSL
-        // kernel has no pair twin; the free table's moments are `(1, 0)` to rounding).
+        // With `pair`, a second dispatch with each point's base (the WGSL kernel has no
+        // pair twin; the free table's moments are `(1, 0)` to rounding).
         let mut batch = |key: Option<SpecKey>, sel: &[usize], pair: bool| {
             let sat = match key {
                 None => &built.lambert,
@@ -875,7 +1085,14 @@ pub fn render_built_gpu(
             };
             let s = run(sel.iter().map(|&q| &ms[q]).collect())?;
             let u = if pair {
-                run(vec![&free; sel.len()])?
+                run(sel
+                    .iter()
+                    .map(|&q| match &bases[q] {
+                        Base::Free => &free,
+                        Base::Same => &ms[q],
+                        Base::Map(m) => m,
+                    })
+                    .collect())?
             } else {
                 vec![[0.0; 3]; sel.len()]
             };

@@ -693,20 +693,24 @@ pub fn shade_moments_x8(
     brdf: &IsoBrdfTables<'_>,
     lights: &[ShadeLight],
 ) -> Option<[[f32; 3]; 8]> {
-    moments_x8::<false>(points, brdf, lights).map(|(s, _)| s)
+    moments_x8::<false>(points, brdf, lights, None).map(|(s, _)| s)
 }
 
 /// RGB of eight lanes: the shadowed `S` and the unshadowed `U` of [`shade_moments_pair_x8`].
 pub type PairX8 = ([[f32; 3]; 8], [[f32; 3]; 8]);
 
-/// [`shade_moments_x8`] and the same with nothing occluded, from one BRDF lookup per light
-/// (`steradian_core::rsl::shade::shade_moments_pair`): `(S, U)` per lane.
+/// [`shade_moments_x8`] under two visibilities from one BRDF lookup per light
+/// (`steradian_core::rsl::shade::shade_moments_pair`): `(S, U)` per lane, `S` under each
+/// point's tables and `U` under `base` (per lane, the same side as the points' tables) or,
+/// without it, with nothing occluded. `None` as [`shade_moments_x8`], or for a `base`
+/// table of another side.
 pub fn shade_moments_pair_x8(
     points: &[MomentsInput<'_>; 8],
     brdf: &IsoBrdfTables<'_>,
     lights: &[ShadeLight],
+    base: Option<&[VisMomentsView<'_>; 8]>,
 ) -> Option<PairX8> {
-    moments_x8::<true>(points, brdf, lights)
+    moments_x8::<true>(points, brdf, lights, base)
 }
 
 /// One light's contribution per lane from the BRDF's `(I, g)` and the visibility's
@@ -753,18 +757,20 @@ fn moments_contribution_x8(
     out
 }
 
-/// The moments kernel for 8 points; with `PAIR`, also the same with nothing occluded
-/// (`f = 1`, `m = 0`; otherwise the second result is zeros).
+/// The moments kernel for 8 points; with `PAIR`, also the same under `base` (or with
+/// nothing occluded, `f = 1`, `m = 0`; without `PAIR` the second result is zeros).
 #[inline(always)]
 fn moments_x8<const PAIR: bool>(
     points: &[MomentsInput<'_>; 8],
     brdf: &IsoBrdfTables<'_>,
     lights: &[ShadeLight],
+    base: Option<&[VisMomentsView<'_>; 8]>,
 ) -> Option<PairX8> {
     let tabs = brdf.tables;
     let (bw, bh) = brdf_size(brdf)?;
     let n = points[0].vis.side();
-    if points.iter().any(|p| p.vis.side() != n) {
+    let other_side = |v: &VisMomentsView<'_>| v.side() != n;
+    if points.iter().any(|p| other_side(&p.vis)) || base.is_some_and(|b| b.iter().any(other_side)) {
         return None;
     }
     let lanes = PointLanes::new(points.map(|p| p.frame), points.map(|p| p.wo), brdf);
@@ -787,8 +793,11 @@ fn moments_x8<const PAIR: bool>(
             *a += sel(live, o, f32x8::ZERO) + lanes.nan;
         }
         if PAIR {
-            let free = (f32x8::ONE, [f32x8::ZERO; 2]);
-            let out = moments_contribution_x8(&lanes, l, (px, py, r), (i, g), free);
+            let fm = match base {
+                Some(b) => vis_moments_lanes(b, n, px, py, r),
+                None => (f32x8::ONE, [f32x8::ZERO; 2]),
+            };
+            let out = moments_contribution_x8(&lanes, l, (px, py, r), (i, g), fm);
             for (a, o) in acc_free.iter_mut().zip(out) {
                 *a += sel(live, o, f32x8::ZERO) + lanes.nan;
             }
@@ -816,27 +825,38 @@ pub fn shade_moments_batch(
 }
 
 /// [`shade_moments_batch`] with [`shade_moments_pair_x8`]: `out[i]` and `free[i]` for
-/// `points[i]`; `false` as [`shade_moments_batch`] (or when `free`'s length differs).
+/// `points[i]`, `free[i]` under `base[i]` (nothing occluded without `base`); `false` as
+/// [`shade_moments_batch`] (or when a length differs, or a `base` table's side does).
 pub fn shade_moments_pair_batch(
     points: &[MomentsInput<'_>],
     brdf: &IsoBrdfTables<'_>,
     lights: &[ShadeLight],
+    base: Option<&[VisMomentsView<'_>]>,
     out: &mut [[f32; 3]],
     free: &mut [[f32; 3]],
 ) -> bool {
-    if free.len() != points.len() || out.len() != points.len() {
+    if free.len() != points.len()
+        || out.len() != points.len()
+        || base.is_some_and(|b| b.len() != points.len())
+    {
         return false;
     }
     let Some(last) = points.last() else {
         return true;
     };
-    for ((group, o), u) in points
+    for (k, ((group, o), u)) in points
         .chunks(8)
         .zip(out.chunks_mut(8))
         .zip(free.chunks_mut(8))
+        .enumerate()
     {
         let g: [MomentsInput<'_>; 8] = core::array::from_fn(|j| *group.get(j).unwrap_or(last));
-        let Some((s, f)) = shade_moments_pair_x8(&g, brdf, lights) else {
+        // The tail padded like the points: with the last base table.
+        let b: Option<[VisMomentsView<'_>; 8]> = base.map(|b| {
+            let chunk = &b[8 * k..];
+            core::array::from_fn(|j| *chunk.get(j).unwrap_or(&b[b.len() - 1]))
+        });
+        let Some((s, f)) = shade_moments_pair_x8(&g, brdf, lights, b.as_ref()) else {
             return false;
         };
         o.copy_from_slice(&s[..o.len()]);
