@@ -609,10 +609,12 @@ fn hvl_method_against_the_path_tracer_on_a_small_room() {
 
 /// The `rsl` method (K = 30, with the shadow ratio) on a small `environment` scene against
 /// the path tracer (direct light): noise-corrected relative L2 within 1.2 % (measured
-/// 0.97 %; the RSL paper's 0.35 % is not met; the test prints the measured errors), under
-/// half the paper's pipeline's (no shadow ratio, measured 2.1 %), most of the squared error
-/// on the glossy sphere (measured 0.90 of it) and the other pixels alone within 0.5 %
-/// (measured 0.32 %).
+/// 0.94 %), under half the paper's pipeline's (no shadow ratio, measured 2.1 %), and the
+/// pixels off the glossy sphere alone within 0.5 % (measured 0.29 %). The rest sits on the
+/// glossy sphere, and it is the reference's noise there, not the method's error (the
+/// standard error of 512 samples underestimates the sun's glossy reflection):
+/// `rsl_glossy_sphere_against_its_exact_integral` measures the sphere noise-free at 0.10 %.
+/// The RSL paper's 0.35 % is judged by the report's 4096-sample reference.
 #[test]
 fn rsl_method_against_the_path_tracer_on_a_small_environment_scene() {
     use steradian_harness::scene::rsl;
@@ -647,8 +649,7 @@ fn rsl_method_against_the_path_tracer_on_a_small_environment_scene() {
         2.0 * m.rel_l2_noise_corrected < paper.rel_l2_noise_corrected,
         "{m:?} vs {paper:?}"
     );
-    // Where the error is: the glossy sphere holds most of the noise-corrected squared
-    // error; the other pixels alone are within 0.5 %.
+    // The glossy sphere (judged noise-free by its own test) apart from the other pixels.
     let s = &small.scene;
     let glossy = s.material_names.iter().position(|n| n == "glossy").unwrap();
     let (w, r) = (s.camera.width, &small.reference);
@@ -675,8 +676,88 @@ fn rsl_method_against_the_path_tracer_on_a_small_environment_scene() {
     eprintln!(
         "glossy sphere's share of the squared error {share:.3}; the others' rel L2 {others:.4}"
     );
-    assert!(share > 0.7, "{share}");
     assert!(others < 0.005, "{others}");
+}
+
+/// The `rsl` method's glossy sphere on `environment` (48 columns, K = 30) against its exact
+/// reflected radiance, noise-free: `∫ L·V·f_r·cos` by the midpoint rule over 1024 × 512
+/// direction cells (2 × 2 per environment texel) with a shadow ray each. The path-traced
+/// reference cannot judge it: the sun's glossy reflection leaves its 512-sample noise
+/// above the method's error. With the shadow ratio (exact integrals through the floor's
+/// half-space, the squares' ratio for the other spheres, the horizon term where the lobe
+/// crosses the sphere's own horizon) the relative L2 over the sphere's pixels is within
+/// 0.3 % (measured 0.10 %); the paper's pipeline is over 5 % (measured 8.3 %), the uniform
+/// squares seen through the lobe.
+#[test]
+fn rsl_glossy_sphere_against_its_exact_integral() {
+    use rayon::prelude::*;
+    use steradian_harness::scene::rsl;
+    let mut s = Scene::load("builtin:environment").unwrap();
+    s.camera = s.camera.resized(48).unwrap();
+    let glossy = s.material_names.iter().position(|n| n == "glossy").unwrap();
+    let (w, h) = (s.camera.width, s.camera.height);
+    let pts: Vec<(usize, scene::ShadingPoint)> = (0..w * h)
+        .filter_map(|k| match s.see(&s.camera.centre_ray(k % w, k / w)) {
+            scene::Seen::Surface(p) if p.material == glossy => Some((k as usize, p)),
+            _ => None,
+        })
+        .collect();
+    assert!(pts.len() > 150, "{}", pts.len());
+    let (qw, qh) = (1024usize, 512usize);
+    let dirs: Vec<(DVec3, f64, [f64; 3])> = (0..qw * qh)
+        .map(|q| {
+            let (i, j) = (q % qw, q / qw);
+            let (t0, t1) = (PI * j as f64 / qh as f64, PI * (j + 1) as f64 / qh as f64);
+            let (t, ph) = (0.5 * (t0 + t1), TAU * (i as f64 + 0.5) / qw as f64);
+            let d = DVec3::new(t.sin() * ph.cos(), t.sin() * ph.sin(), t.cos());
+            (
+                d,
+                TAU / qw as f64 * (t0.cos() - t1.cos()),
+                s.environment_radiance(d),
+            )
+        })
+        .collect();
+    let exact: Vec<[f64; 3]> = pts
+        .par_iter()
+        .map(|(_, p)| {
+            let mat = &s.materials[p.material];
+            let mut out = [0.0; 3];
+            for (d, a, l) in &dirs {
+                let c = d.dot(p.n);
+                if c <= 0.0 || s.occluded(&Ray { o: p.x, d: *d }, 1e-7, f64::INFINITY) {
+                    continue;
+                }
+                let f = mat.eval(p.n, p.wo, *d);
+                for k in 0..3 {
+                    out[k] += a * l[k] * f[k] * c;
+                }
+            }
+            out
+        })
+        .collect();
+    let rel_l2 = |img: &Image| {
+        let (mut e2, mut r2) = (0.0, 0.0);
+        for ((k, _), x) in pts.iter().zip(&exact) {
+            for (got, want) in img.data[*k].iter().zip(x) {
+                e2 += (got - want).powi(2);
+                r2 += want * want;
+            }
+        }
+        (e2 / r2).sqrt()
+    };
+    let render = |exact_unshadowed: bool| {
+        let o = rsl::Options {
+            exact_unshadowed,
+            ..rsl::Options::default()
+        };
+        rsl::render(&s, &o, &ProgressBar::hidden()).unwrap()
+    };
+    let (ratio, paper) = (rel_l2(&render(true)), rel_l2(&render(false)));
+    eprintln!(
+        "glossy sphere, relative L2 against the exact integral: shadow ratio {ratio:.4}, the paper's pipeline {paper:.4}"
+    );
+    assert!(ratio < 0.003, "{ratio}");
+    assert!(paper > 0.05, "{paper}");
 }
 
 /// The noise-corrected relative L2 recovers a method's error against the noise-free image

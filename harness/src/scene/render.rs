@@ -231,9 +231,11 @@ pub fn plan(scene: &Scene, o: &Options) -> Result<Plan, String> {
                 item: "shadow_ratio".into(),
                 value: json!(r.exact_unshadowed),
                 reason: format!(
-                    "each BRDF part's exact unshadowed integral from environment tables (the \
-                     diffuse one; one per glossy lobe exponent up to {}, not GGX) times the \
-                     squares' shadowed-to-unshadowed ratio; off, the RSL paper's eq. 5 alone",
+                    "each BRDF part's exact integral under the point's planes from environment \
+                     tables (the diffuse one; one per glossy lobe exponent up to {}, not GGX; \
+                     per side of the planes) times the squares' ratio of its value under every \
+                     occluder to its value under the planes alone; off, the RSL paper's eq. 5 \
+                     alone",
                     super::unshadowed::MAX_EXPONENT
                 ),
             });

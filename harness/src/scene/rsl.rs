@@ -15,10 +15,10 @@
 //!   hemisphere of directions toward it: a cap of half-angle π/2), on an
 //!   [`Options::vis_side`]² grid of the hemisphere map, turned into moment tables.
 //! - By default ([`Options::exact_unshadowed`], an addition to the paper) each part's
-//!   value is its exact unshadowed integral ([`super::unshadowed`]) times the kernel's
-//!   ratio `S/U` of the point's value to the same with nothing occluded, where the part
-//!   has such an integral (Lambert, Phong and Lafortune lobes up to exponent
-//!   [`super::unshadowed::MAX_EXPONENT`]); GGX keeps `S`.
+//!   value is its exact integral under the point's planes ([`super::unshadowed`], per
+//!   [`PlaneSides`]) times the kernel's ratio `S/U` of the point's value to the same under
+//!   its planes alone ([`Base`]), where the part has such an integral (Lambert, Phong and
+//!   Lafortune lobes up to exponent [`super::unshadowed::MAX_EXPONENT`]); GGX keeps `S`.
 //! - Spherical lights are not lit by this method (the `lobes` method lights with them);
 //!   they are seen by the camera and occlude.
 
@@ -59,10 +59,10 @@ pub struct Options {
     /// ([`steradian_core::rsl::visibility::coverage_into_depth`]).
     pub vis_depth: u32,
     /// The shadow ratio (an addition to the paper's pipeline, on by default): each BRDF
-    /// part's exact unshadowed integral from environment tables
-    /// ([`super::unshadowed::EnvTables`]) times the kernel's shadowed-to-unshadowed ratio
-    /// `S/U` (both over the same squares), instead of `S` alone. Off, the method is the
-    /// paper's pipeline.
+    /// part's exact integral under the point's planes from environment tables
+    /// ([`super::unshadowed::EnvTables`]) times the kernel's ratio `S/U` of its value under
+    /// every occluder to its value under the planes alone (both over the same squares),
+    /// instead of `S` alone. Off, the method is the paper's pipeline.
     pub exact_unshadowed: bool,
 }
 
