@@ -378,9 +378,9 @@ fn lobe_table(env: &Environment, visible: &[DVec3], e: f64) -> LobeTable {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use std::f64::consts::FRAC_PI_2;
     use crate::rng::Rng;
     use crate::scene::Scene;
+    use std::f64::consts::FRAC_PI_2;
 
     /// `(direction, solid angle, radiance)` of the bilinear environment the path tracer
     /// sees through the half-spaces of `visible`, sampled 2 × 2 per texel (8 × 8 where a
