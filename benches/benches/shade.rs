@@ -1,7 +1,9 @@
 //! RSL shading (`steradian_core::rsl::shade`): scalar vs SIMD (8 points per call) over the same
 //! points × K lights, for a diffuse and a glossy BRDF SAT, and the scalar moments kernel
 //! (`shade_moments`: linear BRDF, linear light, visibility moments) and its SIMD twin beside
-//! them. Throughput is in RSL evaluations (points × K) per second.
+//! them, and the pair kernels of the `rsl` method's shadow ratio (`shade_moments_pair`: the
+//! same pass with a second visibility, here the point's own tables) to read their cost
+//! against the single kernels. Throughput is in RSL evaluations (points × K) per second.
 //!
 //! `cargo bench -p steradian-benches --bench shade`
 
@@ -12,7 +14,9 @@ use steradian_core::lobe::brdf::{Brdf, Lambert, Phong};
 use steradian_core::rsl::shade::{self, ShadeLight, VdtQuery, VdtVisibility};
 use steradian_harness::env::{self, decompose};
 use steradian_harness::shade::{self as sh, Scene};
-use steradian_simd::rsl::shade::{IsoBrdfTables, MomentsInput, shade_batch, shade_moments_batch};
+use steradian_simd::rsl::shade::{
+    IsoBrdfTables, MomentsInput, shade_batch, shade_moments_batch, shade_moments_pair_batch,
+};
 
 fn bench(c: &mut Criterion) {
     let cube = env::default_sky(32).unwrap();
@@ -70,11 +74,43 @@ fn bench(c: &mut Criterion) {
                     s
                 })
             });
+            g.bench_function(format!("{mname}/K{}/moments_pair_scalar", d.k), |b| {
+                b.iter(|| {
+                    let mut s = 0.0f32;
+                    for (p, m) in scene.points.iter().zip(&moments) {
+                        let (a, u) = shade::shade_moments_pair(
+                            &p.frame,
+                            p.wo,
+                            &sat,
+                            m,
+                            m,
+                            black_box(&lights),
+                        );
+                        s += a[1] + u[1];
+                    }
+                    s
+                })
+            });
             let mut out = vec![[0.0f32; 3]; inputs.len()];
             g.bench_function(format!("{mname}/K{}/moments_simd", d.k), |b| {
                 b.iter(|| {
                     shade_moments_batch(&minputs, &tables, black_box(&lights), &mut out);
                     out[0][1]
+                })
+            });
+            let base: Vec<_> = minputs.iter().map(|m| m.vis).collect();
+            let mut free = vec![[0.0f32; 3]; inputs.len()];
+            g.bench_function(format!("{mname}/K{}/moments_pair_simd", d.k), |b| {
+                b.iter(|| {
+                    shade_moments_pair_batch(
+                        &minputs,
+                        &tables,
+                        black_box(&lights),
+                        Some(&base),
+                        &mut out,
+                        &mut free,
+                    );
+                    out[0][1] + free[0][1]
                 })
             });
             g.bench_function(format!("{mname}/K{}/simd", d.k), |b| {
