@@ -559,12 +559,11 @@ pub fn point_moments(
     p: &ShadingPoint,
     cov: &mut [f32],
 ) -> Option<(Frame, VisMoments)> {
-    let frame = Frame::from_normal(p.n.as_vec3()).ok()?;
-    let (mut caps, planes) = occluder_caps(scene, p, &frame);
-    caps.extend(planes);
-    coverage_into_depth(&caps, o.vis_side, Outside::Visible, o.vis_depth, cov).ok()?;
-    let moments = VisMoments::build_coverage(o.vis_side, cov).ok()?;
-    Some((frame, moments))
+    let o = Options {
+        exact_unshadowed: false,
+        ..*o
+    };
+    point_vis(scene, &o, p, cov).map(|(frame, moments, _)| (frame, moments))
 }
 
 /// [`point_moments`] with the point's [`Base`] (its planes' own map built where spheres
