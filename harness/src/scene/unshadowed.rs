@@ -4,19 +4,22 @@
 //! The `rsl` kernel estimates a BRDF part's reflected light `∫ L·V·φ` over `K` uniform
 //! squares. Most of its error on the built-in `environment` scene is the light's variation
 //! inside each square, seen sharply through a glossy lobe, and it is there with or
-//! without occluders. The ratio form keeps the squares only for the fraction that
-//! visibility removes:
+//! without occluders. The ratio form keeps the squares only for the fraction that the
+//! spheres remove, with `V = V_P·V_S` split into the point's planes and its spheres:
 //!
 //! ```text
-//!   ∫ L·V·φ ≈ X · S/U,    X = ∫ L·φ (these tables),    S = RSL(L, V, φ),    U = RSL(L, 1, φ)
+//!   ∫ L·V·φ ≈ X · S/U,    X = ∫ L·V_P·φ (these tables),    S = RSL(L, V, φ),    U = RSL(L, V_P, φ)
 //! ```
 //!
-//! It is exact wherever nothing is occluded (`S = U`), up to the tables' error, and
-//! otherwise as good as the squares' estimate of the visible fraction. This is the ratio
-//! estimator of Heitz, Hill and McGuire, "Combining analytic direct illumination and
-//! stochastic shadows" (I3D 2018), with the squares in place of the stochastic shadows.
+//! A plane hides exactly the directions that head toward it, so `V_P` is the indicator
+//! of the half-spaces `v·ω > 0` its planes leave open, the same for every point on the
+//! same sides of them: one set of tables per such signature. The form is exact wherever
+//! only planes occlude (`S = U`), up to the tables' error, and otherwise as good as the
+//! squares' estimate of the fraction the spheres remove. This is the ratio estimator of
+//! Heitz, Hill and McGuire, "Combining analytic direct illumination and stochastic
+//! shadows" (I3D 2018), with the squares in place of the stochastic shadows.
 //!
-//! The tables hold, per environment (times its scale):
+//! The tables hold, per environment (times its scale) and signature:
 //! - the diffuse part `φ = cos⁺/π`: `X(n) = (1/π)∫ L(ω)·max(n·ω, 0) dω`, a function of
 //!   the normal alone, on a [`SphereTable`] of [`DIFFUSE_NODES`];
 //! - a lobe `φ = max(a·ω, 0)^e·max(n·ω, 0)`: wherever the lobe's support lies above the
@@ -29,8 +32,10 @@
 //!   width below the horizon; it blends to `None` at two (the caller then keeps the
 //!   squares' estimate).
 //!
-//! Both are integrals of the environment box-averaged to a grid of cells finer than the
-//! integrand's features ([`LOBE_NODES_PER_WIDTH`] and [`LOBE_CELLS_PER_WIDTH`] to the lobe's width `1/√e`), taken at the table's nodes and interpolated bilinearly.
+//! Both are integrals of the environment (cut by the half-spaces) box-averaged to a grid
+//! of cells finer than the integrand's features ([`LOBE_NODES_PER_WIDTH`] and
+//! [`LOBE_CELLS_PER_WIDTH`] to the lobe's width `1/√e`), taken at the table's nodes and
+//! interpolated bilinearly.
 //! The harness test `env_tables_match_a_brute_force_integral` asserts the error bounds
 //! [`DIFFUSE_REL_TOL`], [`LOBE_REL_TOL`] (lobe clear of the horizon) and
 //! [`LOBE_HORIZON_REL_TOL`] (across it) against an `f64` integral of the bilinear
