@@ -621,3 +621,78 @@ fn shade_bad_lanes_and_mismatched_tables() {
     };
     assert!(shade_x8(&input, &one, VdtQuery::Gradient, &s.lights).is_none());
 }
+
+/// The pair batch over 11 points (a full group and a padded tail), with and without base
+/// tables: `S` is `shade_moments_batch`'s bit for bit and `U` the scalar pair's within
+/// `MOMENTS_REL_TOL`; mismatched lengths are refused.
+#[test]
+fn moments_pair_batch_covers_the_tail() {
+    use steradian_simd::rsl::shade::{shade_moments_batch, shade_moments_pair_batch};
+    let s = setup(true);
+    let mut rng = Rng(23);
+    let (a, b) = (points(&mut rng, None), points(&mut rng, None));
+    let pts: Vec<(Frame, Vec3)> = a.iter().chain(&b[..3]).copied().collect();
+    let views = views(&s.sat);
+    let tables = IsoBrdfTables {
+        tables: &views,
+        s_max: s.sat.s_max(),
+    };
+    let input: Vec<MomentsInput<'_>> = pts
+        .iter()
+        .enumerate()
+        .map(|(k, p)| MomentsInput {
+            frame: p.0,
+            wo: p.1,
+            vis: s.moments[k % 8].view(),
+        })
+        .collect();
+    let base: Vec<_> = (0..pts.len())
+        .map(|k| s.moments[(k + 3) % 8].view())
+        .collect();
+    let n = input.len();
+    let mut single = vec![[0.0f32; 3]; n];
+    assert!(shade_moments_batch(&input, &tables, &s.lights, &mut single));
+    let bits = |v: [f32; 3]| v.map(f32::to_bits);
+    for b in [None, Some(base.as_slice())] {
+        let (mut out, mut free) = (vec![[0.0f32; 3]; n], vec![[0.0f32; 3]; n]);
+        assert!(shade_moments_pair_batch(
+            &input, &tables, &s.lights, b, &mut out, &mut free
+        ));
+        for k in 0..n {
+            assert_eq!(bits(out[k]), bits(single[k]), "point {k}");
+            let p = &input[k];
+            let u = match b {
+                None => core_shade::shade_moments_pair(
+                    &p.frame,
+                    p.wo,
+                    &s.sat,
+                    &p.vis,
+                    &core_shade::Unoccluded,
+                    &s.lights,
+                ),
+                Some(b) => {
+                    core_shade::shade_moments_pair(&p.frame, p.wo, &s.sat, &p.vis, &b[k], &s.lights)
+                }
+            }
+            .1;
+            assert!(
+                close(free[k], u, MOMENTS_REL_TOL),
+                "point {k}: {:?} vs {u:?}",
+                free[k]
+            );
+        }
+    }
+    let mut short = vec![[0.0f32; 3]; n - 1];
+    let mut out = vec![[0.0f32; 3]; n];
+    assert!(!shade_moments_pair_batch(
+        &input, &tables, &s.lights, None, &mut out, &mut short
+    ));
+    assert!(!shade_moments_pair_batch(
+        &input,
+        &tables,
+        &s.lights,
+        Some(&base[..n - 1]),
+        &mut out,
+        &mut vec![[0.0f32; 3]; n]
+    ));
+}

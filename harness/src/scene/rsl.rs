@@ -418,16 +418,22 @@ pub fn choose_k(scene: &Scene, o: &Options, target: f64) -> Result<KChoice, Stri
 /// opposite, per plane ([`open_half_spaces`]).
 pub type PlaneSides = Vec<(usize, bool)>;
 
-/// The planes `x` (on object `own`) is not on, with its side of each ([`PlaneSides`]; the
-/// same test as [`point_moments`]).
+/// The side of the plane through `point` with unit `normal` that `x` is on (`true`: the
+/// side the normal points to), `None` when `x` is on the plane (within `1e-6` of its
+/// scale).
+fn side_of(point: DVec3, normal: DVec3, x: DVec3) -> Option<bool> {
+    let s = normal.dot(x - point);
+    (s.abs() > 1e-6 * (1.0 + x.abs().max_element())).then_some(s > 0.0)
+}
+
+/// The planes `x` (on object `own`) is not on, with its side of each ([`PlaneSides`]).
 pub fn plane_sides(scene: &Scene, x: DVec3, own: usize) -> PlaneSides {
     let mut out = Vec::new();
     for (id, obj) in scene.objects.iter().enumerate() {
-        if let (true, Shape::Plane { point, normal }) = (id != own, obj.shape) {
-            let s = normal.dot(x - point);
-            if s.abs() > 1e-6 * (1.0 + x.abs().max_element()) {
-                out.push((id, s > 0.0));
-            }
+        if let (true, Shape::Plane { point, normal }) = (id != own, obj.shape)
+            && let Some(up) = side_of(point, normal, x)
+        {
+            out.push((id, up));
         }
     }
     out
@@ -482,11 +488,11 @@ fn plane_signatures(scene: &Scene) -> Vec<PlaneSides> {
                     normal: m,
                 } => {
                     if normal.dot(m).abs() >= 1.0 - 1e-12 {
-                        let d = normal.dot(q - point);
-                        if d.abs() <= 1e-6 * (1.0 + q.abs().max_element()) {
+                        // Parallel: one side, or none for the same plane twice.
+                        let Some(up) = side_of(point, normal, q) else {
                             continue;
-                        }
-                        vec![d > 0.0]
+                        };
+                        vec![up]
                     } else {
                         vec![true, false]
                     }
@@ -765,7 +771,11 @@ fn shade_with(
             Base::Free => {
                 shade::shade_moments_pair(frame, wo, sat, moments, &Unoccluded, &b.lights)
             }
-            Base::Same => shade::shade_moments_pair(frame, wo, sat, moments, moments, &b.lights),
+            // Only planes occlude: `U = S`, one pass.
+            Base::Same => {
+                let s = shade::shade_moments(frame, wo, sat, moments, &b.lights);
+                (s, s)
+            }
             Base::Map(m) => shade::shade_moments_pair(frame, wo, sat, moments, m, &b.lights),
         };
         part_value(s, Some(u), x)
@@ -795,13 +805,14 @@ fn shade_by_part(
     points: &[ShadingPoint],
     batch: &mut PartBatch<'_>,
 ) -> Result<Vec<Rgb>, String> {
+    // Each point's tables, once for all its parts.
+    let tables: Vec<Option<&EnvTables>> =
+        points.iter().map(|p| tables_at(scene, built, p)).collect();
     // One part over the points `sel`: the kernel's values through the ratio.
     let mut part = |key: Option<SpecKey>, sel: &[usize]| -> Result<Vec<Rgb>, String> {
         let x: Vec<Option<(Rgb, f64)>> = sel
             .iter()
-            .map(|&q| {
-                tables_at(scene, built, &points[q]).and_then(|t| exact_part(t, key, &points[q]))
-            })
+            .map(|&q| tables[q].and_then(|t| exact_part(t, key, &points[q])))
             .collect();
         let pair = x.iter().any(Option::is_some);
         let su = batch(key, sel, pair)?;
@@ -916,38 +927,58 @@ pub fn render_built_simd(
                 let mut out = vec![[0.0f32; 3]; sel.len()];
                 let mut free = vec![[0.0f32; 3]; sel.len()];
                 let ok = if pair {
-                    // Two runs: the points whose `U` sees everything, then those with a
-                    // base map (their planes' own, or their own tables).
-                    let based: Vec<usize> = (0..sel.len())
-                        .filter(|&k| !matches!(pts[sel[k]].4, Base::Free))
-                        .collect();
-                    let unbased: Vec<usize> = (0..sel.len())
-                        .filter(|&k| matches!(pts[sel[k]].4, Base::Free))
-                        .collect();
+                    // Three runs by the points' bases: `U` seeing everything (`Free`),
+                    // `U = S` (`Same`, one pass), `U` under the planes' own map (`Map`).
                     let mut ok = true;
-                    for (group, with_base) in [(unbased, false), (based, true)] {
+                    for kind in 0..3 {
+                        let group: Vec<usize> = (0..sel.len())
+                            .filter(|&k| {
+                                kind == match pts[sel[k]].4 {
+                                    Base::Free => 0,
+                                    Base::Same => 1,
+                                    Base::Map(_) => 2,
+                                }
+                            })
+                            .collect();
                         if group.is_empty() {
                             continue;
                         }
                         let inp: Vec<MomentsInput<'_>> = group.iter().map(|&k| input[k]).collect();
-                        let views: Vec<_> = group
-                            .iter()
-                            .map(|&k| match &pts[sel[k]].4 {
-                                Base::Map(m) => m.view(),
-                                _ => pts[sel[k]].3.view(),
-                            })
-                            .collect();
-                        let (mut o2, mut f2) =
-                            (vec![[0.0; 3]; group.len()], vec![[0.0; 3]; group.len()]);
-                        let b = with_base.then_some(views.as_slice());
-                        ok &= shade_moments_pair_batch(
-                            &inp,
-                            &tables,
-                            &built.lights,
-                            b,
-                            &mut o2,
-                            &mut f2,
-                        );
+                        let n = group.len();
+                        let (mut o2, mut f2) = (vec![[0.0; 3]; n], vec![[0.0; 3]; n]);
+                        ok &= match kind {
+                            0 => shade_moments_pair_batch(
+                                &inp,
+                                &tables,
+                                &built.lights,
+                                None,
+                                &mut o2,
+                                &mut f2,
+                            ),
+                            1 => {
+                                let done =
+                                    shade_moments_batch(&inp, &tables, &built.lights, &mut o2);
+                                f2.copy_from_slice(&o2);
+                                done
+                            }
+                            _ => {
+                                let views: Vec<_> = group
+                                    .iter()
+                                    .filter_map(|&k| match &pts[sel[k]].4 {
+                                        Base::Map(m) => Some(m.view()),
+                                        _ => None,
+                                    })
+                                    .collect();
+                                shade_moments_pair_batch(
+                                    &inp,
+                                    &tables,
+                                    &built.lights,
+                                    Some(&views),
+                                    &mut o2,
+                                    &mut f2,
+                                )
+                            }
+                        };
                         for (j, &k) in group.iter().enumerate() {
                             out[k] = o2[j];
                             free[k] = f2[j];
@@ -1083,18 +1114,37 @@ pub fn render_built_gpu(
                 .map_err(|e| e.to_string())
             };
             let s = run(sel.iter().map(|&q| &ms[q]).collect())?;
-            let u = if pair {
-                run(sel
-                    .iter()
-                    .map(|&q| match &bases[q] {
-                        Base::Free => &free,
-                        Base::Same => &ms[q],
-                        Base::Map(m) => m,
-                    })
-                    .collect())?
+            // `U` for the points with another base than their own tables (`Same`: `U = S`).
+            let other: Vec<usize> = (0..sel.len())
+                .filter(|&k| pair && !matches!(bases[sel[k]], Base::Same))
+                .collect();
+            let mut u = if pair {
+                s.clone()
             } else {
                 vec![[0.0; 3]; sel.len()]
             };
+            if !other.is_empty() {
+                let sub_pts: Vec<ShadePoint> = other.iter().map(|&k| pts[sel[k]].clone()).collect();
+                let base: Vec<&VisMoments> = other
+                    .iter()
+                    .map(|&k| match &bases[sel[k]] {
+                        Base::Map(m) => m,
+                        _ => &free,
+                    })
+                    .collect();
+                let got = shade_moments_gpu_at(
+                    gpu,
+                    &sub_pts,
+                    sat,
+                    &base,
+                    &built.lights,
+                    GPU_MOMENTS_MAX_TABLE_BYTES,
+                )
+                .map_err(|e| e.to_string())?;
+                for (&k, v) in other.iter().zip(got) {
+                    u[k] = v;
+                }
+            }
             Ok(s.into_iter().zip(u).collect())
         };
         let shaded = shade_by_part(scene, built, &points, &mut batch)?;

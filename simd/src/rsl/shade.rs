@@ -841,28 +841,26 @@ pub fn shade_moments_pair_batch(
     {
         return false;
     }
-    let Some(last) = points.last() else {
-        return true;
-    };
-    for (k, ((group, o), u)) in points
-        .chunks(8)
-        .zip(out.chunks_mut(8))
-        .zip(free.chunks_mut(8))
-        .enumerate()
-    {
-        let g: [MomentsInput<'_>; 8] = core::array::from_fn(|j| *group.get(j).unwrap_or(last));
-        // The tail padded like the points: with the last base table.
-        let b: Option<[VisMomentsView<'_>; 8]> = base.map(|b| {
-            let chunk = &b[8 * k..];
-            core::array::from_fn(|j| *chunk.get(j).unwrap_or(&b[b.len() - 1]))
-        });
+    groups_of_eight(points.len(), |start, idx| {
+        let g = idx.map(|i| points[i]);
+        let b = base.map(|b| idx.map(|i| b[i]));
         let Some((s, f)) = shade_moments_pair_x8(&g, brdf, lights, b.as_ref()) else {
             return false;
         };
-        o.copy_from_slice(&s[..o.len()]);
-        u.copy_from_slice(&f[..u.len()]);
-    }
-    true
+        let n = (points.len() - start).min(8);
+        out[start..start + n].copy_from_slice(&s[..n]);
+        free[start..start + n].copy_from_slice(&f[..n]);
+        true
+    })
+}
+
+/// Calls `x8(start, indices)` on each group of eight of `0..len` (the tail padded with
+/// `len − 1`, so a padded lane repeats the last point), stopping at the first `false`;
+/// `true` when every group (or none) ran.
+fn groups_of_eight(len: usize, mut x8: impl FnMut(usize, [usize; 8]) -> bool) -> bool {
+    (0..len)
+        .step_by(8)
+        .all(|start| x8(start, core::array::from_fn(|j| (start + j).min(len - 1))))
 }
 
 /// `out[i]` = lane `i mod 8` of `x8` on the group of eight points holding `points[i]` (the
@@ -876,17 +874,14 @@ fn by_eight<P: Copy>(
     if points.len() != out.len() {
         return false;
     }
-    let Some(last) = points.last() else {
-        return true;
-    };
-    for (group, o) in points.chunks(8).zip(out.chunks_mut(8)) {
-        let g: [P; 8] = core::array::from_fn(|j| *group.get(j).unwrap_or(last));
-        let Some(r) = x8(&g) else {
+    groups_of_eight(points.len(), |start, idx| {
+        let Some(r) = x8(&idx.map(|i| points[i])) else {
             return false;
         };
-        o.copy_from_slice(&r[..o.len()]);
-    }
-    true
+        let n = (points.len() - start).min(8);
+        out[start..start + n].copy_from_slice(&r[..n]);
+        true
+    })
 }
 
 /// Shades every point (`out[i]` for `points[i]`), 8 at a time; the tail is padded with the
