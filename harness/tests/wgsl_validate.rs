@@ -142,6 +142,7 @@ fn unlisted_kernels_validate_with_the_documented_interface() {
         ("sh-hvl", wgsl::SH_HVL),
         ("sh-hvl-exact", wgsl::SH_HVL_EXACT),
         ("sh-hvl-sum", wgsl::SH_HVL_SUM),
+        ("lobe-chain", wgsl::LOBE_CHAIN),
     ] {
         check_interface(name, src, Some("f32"));
     }

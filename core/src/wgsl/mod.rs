@@ -461,6 +461,7 @@ pub const LOBE_PRODUCT: &str = concat!(
     include_str!("batch.wgsl"),
     include_str!("log1p.wgsl"),
     include_str!("atan2.wgsl"),
+    include_str!("../lobe/product_lib.wgsl"),
     include_str!("../lobe/product.wgsl")
 );
 /// Difference allowed between [`LOBE_PRODUCT`] and `product::product_with`
@@ -474,6 +475,33 @@ pub const LOBE_PRODUCT: &str = concat!(
 /// checked against the same tolerance): axis `1.2e-7`, scale `2.3e-7`, exponent `5.9e-7`,
 /// integral `6.6e-7`.
 pub const LOBE_PRODUCT_TOL: f32 = 1.0e-5;
+
+/// One chain of the harness's `lobes` method (`scene::lobes`): `∫ r·(L·cos)·V` for a
+/// reflectance `r` of a constant and at most one lobe, a light of one lobe `L` (multiplied
+/// by the cosine lobe of the normal first, `sum::light_with_cosine_with`) and a visibility
+/// `V = 1 + Σ` lobes, by `sum::triple_with` twice: unshadowed (threshold 0) and shadowed
+/// (threshold `t·|unshadowed|`), every product by [`LOBE_PRODUCT`]'s `lobe_product`.
+/// Input columns `[nx, ny, nz, lx, ly, lz, ls, le, rk, r_lobes, rx, ry, rz, rs, re,
+/// vis_offset, vis_count, t]` (`vis_offset` and `vis_count` as `u32` bits), output
+/// `[unshadowed, shadowed, products]`. Binding 3 is [`LOBE_PRODUCT`]'s table followed by
+/// the visibility lobes, five `f32` each (axis, scale, exponent), which `vis_offset`
+/// indexes. Not a registered kernel (no `eval` contract; its scalar twin is the harness's
+/// chain); the harness tests `tests/wgsl_validate.rs` (naga) and `tests/scene.rs`
+/// (`lobes_gpu_path_matches_the_scalar_path`, on an adapter) build it. Tolerance:
+/// [`LOBE_CHAIN_REL_TOL`].
+pub const LOBE_CHAIN: &str = concat!(
+    include_str!("batch.wgsl"),
+    include_str!("log1p.wgsl"),
+    include_str!("atan2.wgsl"),
+    include_str!("../lobe/product_lib.wgsl"),
+    include_str!("../lobe/lobe_chain.wgsl")
+);
+/// Difference allowed between [`LOBE_CHAIN`] and the scalar chain, per value, relative to
+/// the chain's unshadowed magnitude: each product is within [`LOBE_PRODUCT_TOL`] and the
+/// chain sums a few dozen of them; a term whose integral lies within that of the pruning
+/// threshold may be kept on one side and dropped on the other, which moves the value by
+/// at most the threshold's share.
+pub const LOBE_CHAIN_REL_TOL: f32 = 1.0e-4;
 
 /// Every kernel as `(name, source)`, the name as in the harness (`hemisphere-map`, …).
 pub const ALL: [(&str, &str); 5] = [
