@@ -496,12 +496,14 @@ pub const LOBE_CHAIN: &str = concat!(
     include_str!("../lobe/product_lib.wgsl"),
     include_str!("../lobe/lobe_chain.wgsl")
 );
-/// Difference allowed between [`LOBE_CHAIN`] and the scalar chain, per value, relative to
-/// the chain's unshadowed magnitude: each product is within [`LOBE_PRODUCT_TOL`] and the
-/// chain sums a few dozen of them; a term whose integral lies within that of the pruning
-/// threshold may be kept on one side and dropped on the other, which moves the value by
-/// at most the threshold's share.
-pub const LOBE_CHAIN_REL_TOL: f32 = 1.0e-4;
+/// Difference allowed between a pixel of the `lobes` method rendered with [`LOBE_CHAIN`]
+/// and with the scalar chains, per channel, relative to the image's largest value: each
+/// product is within [`LOBE_PRODUCT_TOL`] and a chain sums a few dozen, shadows subtracted;
+/// a term whose integral lies at the pruning threshold may be kept on one side and dropped
+/// on the other. Lavapipe (harness test `lobes_gpu_path_matches_the_scalar_path`, `lobes`
+/// and `cluster` at 48 columns, three visibility and diffuse variants): `3.6e-7`, with the
+/// same products computed.
+pub const LOBE_CHAIN_REL_TOL: f32 = 1.0e-5;
 
 /// Every kernel as `(name, source)`, the name as in the harness (`hemisphere-map`, …).
 pub const ALL: [(&str, &str); 5] = [

@@ -42,7 +42,7 @@ use steradian_core::lobe::cap::{CapFit, SphericalCap};
 use steradian_core::lobe::mask::{self, Leaves};
 use steradian_core::lobe::product::{ProductFit, ProductTable, product_with};
 use steradian_core::lobe::sum::{
-    Cosine, LobeSum, LobeVec, ProductCounts, light_with_cosine_with, triple_with,
+    Cosine, LobeSum, LobeTerms, LobeVec, ProductCounts, light_with_cosine_with, triple_with,
 };
 
 use super::image::Image;
@@ -462,6 +462,51 @@ struct Lit<'a> {
     hidden: Option<f64>,
 }
 
+/// The visibility of one light at a receiver as `1 + Σ` lobes (module docs): none where the
+/// light has no occluder, nor where only an exact diffuse term would use them.
+fn visibility(rx: &Receiver, lit: &Lit<'_>, o: &Options) -> LobeVec {
+    let mut vis = LobeVec {
+        constant: 1.0,
+        lobes: Vec::new(),
+    };
+    match o.visibility {
+        Visibility::PerOccluder => {
+            vis.lobes
+                .extend(lit.occluders.iter().map(|oc| oc.lobe(-1.0, o.fit)));
+        }
+        // No occluder, no shadow leaf: the mask is not walked; nor where only the diffuse
+        // term would use it and that is exact.
+        Visibility::Mask { .. }
+            if lit.occluders.is_empty()
+                || (lit.hidden.is_some() && rx.glossy.iter().next().is_none()) => {}
+        Visibility::Mask { depth, leaves } => {
+            let dist = mask::dist_of(lit.cap.half_angle());
+            mask::shadow_leaves(lit.cap, lit.occluders, depth, leaves, |leaf, d| {
+                let w = mask::weight(&mask::WEIGHTS, dist, d);
+                vis.lobes.push(leaf.lobe(-w, o.fit));
+            });
+        }
+    }
+    vis
+}
+
+/// Whether the diffuse term needs its chain: not where it is exact ([`diffuse_hidden`]),
+/// nor where the exact unshadowed value meets no shadow lobe.
+fn diffuse_needs_chain(hidden: Option<f64>, vis: &LobeVec, o: &Options) -> bool {
+    hidden.is_none() && (!o.exact_diffuse || !vis.lobes.is_empty())
+}
+
+/// The constant diffuse reflectance `1/π` of a chain (the albedo is carried in RGB).
+fn diffuse_reflectance() -> LobeSum<1> {
+    LobeSum::with_constant(1.0 / std::f32::consts::PI)
+}
+
+/// A glossy lobe's reflectance of a chain: the unit lobe (its RGB scale carried apart).
+fn glossy_reflectance(g: &super::material::ViewLobe) -> LobeSum<1> {
+    let lobe = CosineLobe::saturating(f32v(g.axis), 1.0, g.exponent as f32);
+    LobeSum::<1>::from_lobes(0.0, &[lobe])
+}
+
 /// Light `li`'s radiance at a receiver `rx` added to `out` (module docs).
 fn shade_light(
     scene: &Scene,
@@ -472,34 +517,7 @@ fn shade_light(
     counts: &mut ProductCounts,
     out: &mut Rgb,
 ) {
-    let Lit {
-        cap,
-        l,
-        occluders,
-        hidden,
-    } = *lit;
-    let light = &scene.lights[li];
-    let mut vis = LobeVec {
-        constant: 1.0,
-        lobes: Vec::new(),
-    };
-    match o.visibility {
-        Visibility::PerOccluder => {
-            vis.lobes
-                .extend(occluders.iter().map(|oc| oc.lobe(-1.0, o.fit)));
-        }
-        // No occluder, no shadow leaf: the mask is not walked; nor where only the diffuse
-        // term would use it and that is exact.
-        Visibility::Mask { .. }
-            if occluders.is_empty() || (hidden.is_some() && rx.glossy.iter().next().is_none()) => {}
-        Visibility::Mask { depth, leaves } => {
-            let dist = mask::dist_of(cap.half_angle());
-            mask::shadow_leaves(cap, occluders, depth, leaves, |leaf, d| {
-                let w = mask::weight(&mask::WEIGHTS, dist, d);
-                vis.lobes.push(leaf.lobe(-w, o.fit));
-            });
-        }
-    }
+    let vis = visibility(rx, lit, o);
     let unoccluded = LobeSum::<1>::unoccluded();
     let table = o.table.table();
     let kernel =
@@ -508,9 +526,11 @@ fn shade_light(
     let mut own = None;
     // A chain's unshadowed and shadowed values.
     let mut chain = |r: &LobeSum<1>| -> (f64, f64) {
-        let l = match l {
+        let l = match lit.l {
             Some(l) => l,
-            None => &*own.get_or_insert_with(|| light_lobe(&kernel, cap, rx.normal, o, counts)),
+            None => {
+                &*own.get_or_insert_with(|| light_lobe(&kernel, lit.cap, rx.normal, o, counts))
+            }
         };
         let u = triple_with(&kernel, r, l, &unoccluded, 0.0, counts);
         if vis.lobes.is_empty() {
@@ -519,33 +539,41 @@ fn shade_light(
         let v = triple_with(&kernel, r, l, &vis, o.threshold * u.abs(), counts);
         (u as f64, v as f64)
     };
-    let diffuse = LobeSum::with_constant(1.0 / std::f32::consts::PI);
-    let exact = || f64::from(cap.clipped_cosine(rx.normal));
-    let i_d = if let Some(hidden) = hidden {
+    let d = diffuse_needs_chain(lit.hidden, &vis, o).then(|| chain(&diffuse_reflectance()));
+    let glossy = rx.glossy.iter().map(|g| chain(&glossy_reflectance(g)).1);
+    add_light(&scene.lights[li], rx, lit, o, d, glossy, out);
+}
+
+/// The light's radiance from its chains' values, added to `out`: `d` the diffuse chain's
+/// `(unshadowed, shadowed)` where [`diffuse_needs_chain`], `glossy` the shadowed value of
+/// each of the receiver's glossy lobes in order. The diffuse term is exact where
+/// [`diffuse_hidden`] is, else (with [`Options::exact_diffuse`]) the exact unshadowed value
+/// times the chain's visible fraction (all of it without a chain, or where the chain leaves
+/// nothing to divide), else the chain's shadowed value.
+fn add_light(
+    light: &super::SphereLight,
+    rx: &Receiver,
+    lit: &Lit<'_>,
+    o: &Options,
+    d: Option<(f64, f64)>,
+    glossy: impl Iterator<Item = f64>,
+    out: &mut Rgb,
+) {
+    let exact = || f64::from(lit.cap.clipped_cosine(rx.normal));
+    let i_d = if let Some(hidden) = lit.hidden {
         // Exact: the unshadowed value less what the occluders hide of it.
         (exact() - hidden).max(0.0) / std::f64::consts::PI
     } else if o.exact_diffuse {
-        // The exact unshadowed value times the lobes' visible fraction (all of it without
-        // shadow lobes, or where the lobes leave nothing to divide).
-        let visible = if vis.lobes.is_empty() {
-            1.0
-        } else {
-            let (u_d, v_d) = chain(&diffuse);
-            if u_d > 0.0 {
-                (v_d / u_d).clamp(0.0, 1.0)
-            } else {
-                1.0
-            }
+        let visible = match d {
+            Some((u_d, v_d)) if u_d > 0.0 => (v_d / u_d).clamp(0.0, 1.0),
+            _ => 1.0,
         };
         exact() / std::f64::consts::PI * visible
     } else {
-        chain(&diffuse).1
+        d.map_or(0.0, |c| c.1)
     };
     let mut acc = rx.diffuse.map(|d| d * i_d);
-    for g in rx.glossy.iter() {
-        let lobe = CosineLobe::saturating(f32v(g.axis), 1.0, g.exponent as f32);
-        let r = LobeSum::<1>::from_lobes(0.0, &[lobe]);
-        let i_g = chain(&r).1;
+    for (g, i_g) in rx.glossy.iter().zip(glossy) {
         for (a, s) in acc.iter_mut().zip(g.scale) {
             *a += s * i_g;
         }
@@ -553,6 +581,181 @@ fn shade_light(
     for c in 0..3 {
         out[c] += light.radiance[c] * acc[c].max(0.0);
     }
+}
+
+/// Shading points per dispatch of [`render_gpu`].
+pub const GPU_BATCH: usize = 2048;
+
+/// One light at one receiver as [`render_gpu`] prepares it on the CPU: its cap, what its
+/// occluders hide of the diffuse term where that is exact, its visibility lobes and
+/// whether the diffuse term needs a chain.
+struct LightPrep {
+    li: usize,
+    cap: SphericalCap,
+    hidden: Option<f64>,
+    vis: LobeVec,
+    diffuse_chain: bool,
+}
+
+/// A receiver and its lit lights, prepared as [`shade`] prepares them.
+fn prepare(scene: &Scene, p: &ShadingPoint, o: &Options) -> (Receiver, Vec<LightPrep>) {
+    let rx = Receiver::of(scene, p);
+    let mut lights = Vec::new();
+    for li in 0..scene.lights.len() {
+        let Some(cap) = light_cap(scene, p, li) else {
+            continue;
+        };
+        let occ = occluders(scene, p, li);
+        let hidden = diffuse_hidden(&cap, &occ, rx.normal, o);
+        let lit = Lit {
+            cap: &cap,
+            l: None,
+            occluders: &occ,
+            hidden,
+        };
+        let vis = visibility(&rx, &lit, o);
+        let diffuse_chain = diffuse_needs_chain(hidden, &vis, o);
+        lights.push(LightPrep {
+            li,
+            cap,
+            hidden,
+            vis,
+            diffuse_chain,
+        });
+    }
+    (rx, lights)
+}
+
+/// The input row of `steradian_core::wgsl::LOBE_CHAIN` for reflectance `r` at normal `n`
+/// under the light lobe `l`, its visibility lobes at `vis` (offset and count in the
+/// table).
+fn chain_row(n: Vec3, l: &CosineLobe, r: &LobeSum<1>, vis: (u32, u32), t: f32) -> [f32; 18] {
+    let (la, rl) = (l.axis(), r.lobes().first());
+    let (ra, rs, re) = rl.map_or((Vec3::Z, 0.0, 0.0), |g| (g.axis(), g.scale(), g.exponent()));
+    [
+        n.x,
+        n.y,
+        n.z,
+        la.x,
+        la.y,
+        la.z,
+        l.scale(),
+        l.exponent(),
+        r.constant(),
+        r.lobes().len() as f32,
+        ra.x,
+        ra.y,
+        ra.z,
+        rs,
+        re,
+        f32::from_bits(vis.0),
+        f32::from_bits(vis.1),
+        t,
+    ]
+}
+
+/// [`render`] on the wgpu backend: [`GPU_BATCH`] points at a time, each point's lights
+/// prepared on the CPU's thread pool as [`shade`] prepares them (caps, occluders, the
+/// quadtree mask's visibility lobes, the exact diffuse term), every chain evaluated by
+/// `steradian_core::wgsl::LOBE_CHAIN` (one row per chain, the light's lobe times the cosine
+/// formed in each), and the chains combined on the CPU as [`shade`] combines them. Each
+/// pixel is within the chains' tolerance of [`render`]'s (harness test
+/// `lobes_gpu_path_matches_the_scalar_path`). The counts are the products computed, the
+/// light's lobe times the cosine counted once per light as [`shade`] counts it; the other
+/// counts stay 0.
+pub fn render_gpu(
+    scene: &Scene,
+    o: &Options,
+    gpu: &mut crate::backend::gpu::Gpu,
+    bar: &ProgressBar,
+) -> Result<(Image, ProductCounts), String> {
+    use super::Seen;
+    use crate::backend::gpu::Custom;
+    use crate::kernels::Columns;
+    use rayon::prelude::*;
+
+    let cam = scene.camera;
+    let (w, h) = (cam.width as usize, cam.height as usize);
+    let mut img = Image::new(w, h);
+    let mut queue = Vec::new();
+    bar.set_length((w * h) as u64);
+    for j in 0..h {
+        for i in 0..w {
+            match scene.see(&cam.centre_ray(i as u32, j as u32)) {
+                Seen::Radiance(l) => img.data[j * w + i] = l,
+                Seen::Surface(p) => queue.push((j * w + i, p)),
+            }
+        }
+    }
+    bar.inc((w * h - queue.len()) as u64);
+    let product_table = o.table.table().gpu_table();
+    let mut counts = ProductCounts::default();
+    for chunk in queue.chunks(GPU_BATCH) {
+        let preps: Vec<(Receiver, Vec<LightPrep>)> = chunk
+            .par_iter()
+            .map(|(_, p)| prepare(scene, p, o))
+            .collect();
+        let mut table = product_table.clone();
+        let mut rows: Vec<[f32; 18]> = Vec::new();
+        for (rx, lights) in &preps {
+            for lp in lights {
+                let chains = usize::from(lp.diffuse_chain) + rx.glossy.len();
+                if chains == 0 {
+                    continue;
+                }
+                counts.computed += 1;
+                let off = u32::try_from(table.len())
+                    .map_err(|_| "lobes --gpu: table beyond u32 indices".to_string())?;
+                for v in &lp.vis.lobes {
+                    let a = v.axis();
+                    table.extend([a.x, a.y, a.z, v.scale(), v.exponent()]);
+                }
+                let vis = (off, lp.vis.lobes.len() as u32);
+                let l = lp.cap.lobe(1.0, o.fit);
+                if lp.diffuse_chain {
+                    rows.push(chain_row(rx.normal, &l, &diffuse_reflectance(), vis, o.threshold));
+                }
+                for g in rx.glossy.iter() {
+                    rows.push(chain_row(rx.normal, &l, &glossy_reflectance(g), vis, o.threshold));
+                }
+            }
+        }
+        let mut out = Columns::zeros(3, rows.len());
+        if !rows.is_empty() {
+            let custom = Custom {
+                label: "lobe-chain",
+                source: steradian_core::wgsl::LOBE_CHAIN,
+                table: Some(&table),
+            };
+            gpu.run_custom(&custom, &Columns::from_rows(&rows), &mut out)
+                .map_err(|e| format!("lobe-chain kernel: {e}"))?;
+        }
+        let n = rows.len();
+        let value = |c: usize, r: usize| f64::from(out.data[c * n + r]);
+        let mut r = 0;
+        for ((px, _), (rx, lights)) in chunk.iter().zip(&preps) {
+            let mut acc = [0.0; 3];
+            for lp in lights {
+                let d = lp.diffuse_chain.then(|| {
+                    r += 1;
+                    (value(0, r - 1), value(1, r - 1))
+                });
+                let glossy: Vec<f64> = (0..rx.glossy.len()).map(|k| value(1, r + k)).collect();
+                r += glossy.len();
+                let lit = Lit {
+                    cap: &lp.cap,
+                    l: None,
+                    occluders: &[],
+                    hidden: lp.hidden,
+                };
+                add_light(&scene.lights[lp.li], rx, &lit, o, d, glossy.into_iter(), &mut acc);
+            }
+            img.data[*px] = acc;
+        }
+        counts.computed += (0..n).map(|r| value(2, r) as u64).sum::<u64>();
+        bar.inc(chunk.len() as u64);
+    }
+    Ok((img, counts))
 }
 
 /// What [`choose_depth`] chose and what it measured.

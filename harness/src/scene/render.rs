@@ -72,7 +72,7 @@ pub struct Options {
     pub quiet: bool,
     /// Shade with the scalar kernels (`rsl`, `lobes` and `hvl` use SIMD kernels otherwise).
     pub scalar: bool,
-    /// Shade on the wgpu backend (`rsl` and `hvl`; an error without an adapter).
+    /// Shade on the wgpu backend (`lobes`, `rsl` and `hvl`; an error without an adapter).
     pub gpu: bool,
 }
 
@@ -162,9 +162,9 @@ pub fn plan(scene: &Scene, o: &Options) -> Result<Plan, String> {
     let mut lo = lobes::Options::default();
     let mut r = super::rsl::Options::default();
     let mut hv = super::hvl::Options::default();
-    if o.gpu && !matches!(o.method, Method::Rsl | Method::Hvl) {
+    if o.gpu && !matches!(o.method, Method::Lobes | Method::Rsl | Method::Hvl) {
         return Err(format!(
-            "--gpu: only methods rsl and hvl have a wgpu path (not {})",
+            "--gpu: only methods lobes, rsl and hvl have a wgpu path (not {})",
             o.method.name()
         ));
     }
@@ -422,11 +422,19 @@ pub fn plan(scene: &Scene, o: &Options) -> Result<Plan, String> {
                 p.push(PlanItem {
                     item: "kernel".into(),
                     value: json!(kernel_name(o)),
-                    reason: if o.scalar {
+                    reason: if o.gpu {
+                        format!(
+                            "--gpu: every lobe chain by the WGSL chain kernel, one chain per \
+                             invocation, {} points per dispatch; each point's caps, occluders and \
+                             quadtree mask on the CPU",
+                            lobes::GPU_BATCH
+                        )
+                    } else if o.scalar {
                         "--scalar: every product by the scalar kernel, one point at a time".into()
                     } else {
                         "each light's lobe times the cosine by the SIMD product kernel, eight \
-                         points at a time, the rest lane by lane (--scalar for the scalar one)"
+                         points at a time, the rest lane by lane (--scalar for the scalar one, \
+                         --gpu for wgpu)"
                             .into()
                     },
                 });
@@ -587,7 +595,11 @@ pub fn run(scene: &Scene, scene_name: &str, o: &Options, plan: &Plan) -> Result<
             (out.image, Some(out.stderr), json!({}))
         }
         Method::Lobes => {
-            let (img, counts) = if o.scalar {
+            let (img, counts) = if o.gpu {
+                let mut gpu = crate::backend::gpu::try_gpu()
+                    .map_err(|e| format!("--gpu: no wgpu adapter: {e}"))?;
+                lobes::render_gpu(scene, &plan.lobes, &mut gpu, &b)?
+            } else if o.scalar {
                 lobes::render(scene, &plan.lobes, &b)
             } else {
                 lobes::render_simd(scene, &plan.lobes, &b)
