@@ -1098,9 +1098,17 @@ fn lobes_gpu_path_matches_the_scalar_path() {
                  largest value over {lit} lit pixels; products {:+.2e} relative",
                 products
             ));
-            assert!(worst <= LOBE_CHAIN_REL_TOL as f64, "{name}, {what}: {worst:e}");
+            assert!(
+                worst <= LOBE_CHAIN_REL_TOL as f64,
+                "{name}, {what}: {worst:e}"
+            );
             assert!(lit > min_lit, "{name}: {lit}");
-            assert!(products.abs() <= 1e-3, "{name}, {what}: {} vs {}", cg.computed, cs.computed);
+            assert!(
+                products.abs() <= 1e-3,
+                "{name}, {what}: {} vs {}",
+                cg.computed,
+                cs.computed
+            );
         }
     }
 }

@@ -218,7 +218,10 @@ fn mask_depth(v: lobes::Visibility) -> u32 {
     }
 }
 
-fn lobes_settings(scene: &Scene) -> (Vec<Setting<'_>>, Vec<Setting<'_>>) {
+fn lobes_settings<'a>(
+    scene: &'a Scene,
+    gpu: Option<&'a std::sync::Mutex<crate::backend::gpu::Gpu>>,
+) -> (Vec<Setting<'a>>, Vec<Setting<'a>>) {
     let px = scene.camera.pixels() as f64;
     let d = planned(scene, render::Method::Lobes).map_or_else(lobes::Options::default, |p| p.lobes);
     // Renders with the SIMD path, `steradian render`'s default; the scalar path at the
@@ -244,6 +247,26 @@ fn lobes_settings(scene: &Scene) -> (Vec<Setting<'_>>, Vec<Setting<'_>>) {
     };
     let mk =
         move |label: String, o: lobes::Options, default: bool| mk_with(label, o, default, true);
+    let mk_gpu = move |gpu: &'a std::sync::Mutex<crate::backend::gpu::Gpu>| Setting {
+        label: format!(
+            "t = {:.0e}, depth {}, wgpu (every chain on the adapter)",
+            d.threshold,
+            mask_depth(d.visibility)
+        ),
+        render: Box::new(move || {
+            let blank = || Image::new(scene.camera.width as usize, scene.camera.height as usize);
+            gpu.lock()
+                .map_err(|_| "adapter lock poisoned".to_string())
+                .and_then(|mut g| lobes::render_gpu(scene, &d, &mut g, &ProgressBar::hidden()))
+                .map_or_else(
+                    |_| (blank(), None),
+                    |(img, c)| (img, Some(c.computed as f64 / px)),
+                )
+        }),
+        default: false,
+        build_seconds: None,
+        per_core: Some("wgpu"),
+    };
     let depth = mask_depth(d.visibility);
     // The curve's thresholds and the planned one (`--target-error`/10).
     let mut thresholds = THRESHOLDS.to_vec();
@@ -274,7 +297,7 @@ fn lobes_settings(scene: &Scene) -> (Vec<Setting<'_>>, Vec<Setting<'_>>) {
             ));
         }
     }
-    let variants = vec![
+    let mut variants = vec![
         mk_with(
             format!("t = {:.0e}, depth {depth}, scalar kernel", d.threshold),
             d,
@@ -321,6 +344,7 @@ fn lobes_settings(scene: &Scene) -> (Vec<Setting<'_>>, Vec<Setting<'_>>) {
             false,
         ),
     ];
+    variants.extend(gpu.map(mk_gpu));
     (curve, variants)
 }
 
@@ -556,7 +580,7 @@ fn measure_scene(
     let (curve_settings, variant_settings) = match method {
         "hvl" => hvl_settings(&scene, gpu),
         "rsl" => rsl_settings(&scene, gpu),
-        _ => lobes_settings(&scene),
+        _ => lobes_settings(&scene, gpu),
     };
     let measure = |st: &Setting<'_>| -> Result<(Point, Image), String> {
         let ((img, products), best) = best_of(|| (st.render)());
@@ -584,9 +608,9 @@ fn measure_scene(
         .iter()
         .map(|st| measure(st).map(|(p, _)| p))
         .collect::<Result<Vec<_>, _>>()?;
-    // Throughput on one core: the default setting (SIMD), the scalar variants and `rsl`'s wgpu variant (one core
-    // building the visibility tables, the adapter shading), each the best of two renders in
-    // a one-thread pool.
+    // Throughput on one core: the default setting (SIMD), the scalar variants and the wgpu
+    // variants (one core preparing the points, the adapter shading), each the best of two
+    // renders in a one-thread pool.
     let surface_points = (0..scene.camera.height)
         .flat_map(|j| (0..scene.camera.width).map(move |i| (i, j)))
         .filter(|&(i, j)| matches!(scene.see(&scene.camera.centre_ray(i, j)), Seen::Surface(_)))

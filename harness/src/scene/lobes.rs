@@ -528,9 +528,7 @@ fn shade_light(
     let mut chain = |r: &LobeSum<1>| -> (f64, f64) {
         let l = match lit.l {
             Some(l) => l,
-            None => {
-                &*own.get_or_insert_with(|| light_lobe(&kernel, lit.cap, rx.normal, o, counts))
-            }
+            None => &*own.get_or_insert_with(|| light_lobe(&kernel, lit.cap, rx.normal, o, counts)),
         };
         let u = triple_with(&kernel, r, l, &unoccluded, 0.0, counts);
         if vis.lobes.is_empty() {
@@ -713,10 +711,22 @@ pub fn render_gpu(
                 let vis = (off, lp.vis.lobes.len() as u32);
                 let l = lp.cap.lobe(1.0, o.fit);
                 if lp.diffuse_chain {
-                    rows.push(chain_row(rx.normal, &l, &diffuse_reflectance(), vis, o.threshold));
+                    rows.push(chain_row(
+                        rx.normal,
+                        &l,
+                        &diffuse_reflectance(),
+                        vis,
+                        o.threshold,
+                    ));
                 }
                 for g in rx.glossy.iter() {
-                    rows.push(chain_row(rx.normal, &l, &glossy_reflectance(g), vis, o.threshold));
+                    rows.push(chain_row(
+                        rx.normal,
+                        &l,
+                        &glossy_reflectance(g),
+                        vis,
+                        o.threshold,
+                    ));
                 }
             }
         }
@@ -748,7 +758,15 @@ pub fn render_gpu(
                     occluders: &[],
                     hidden: lp.hidden,
                 };
-                add_light(&scene.lights[lp.li], rx, &lit, o, d, glossy.into_iter(), &mut acc);
+                add_light(
+                    &scene.lights[lp.li],
+                    rx,
+                    &lit,
+                    o,
+                    d,
+                    glossy.into_iter(),
+                    &mut acc,
+                );
             }
             img.data[*px] = acc;
         }
