@@ -1114,7 +1114,8 @@ fn lobes_gpu_path_matches_the_scalar_path() {
 }
 
 /// The `hvl` method's wgpu path (`render_gpu`: the diffuse indirect light by
-/// `wgsl::SH_HVL_SUM`, shadow rays in `f32`) against the CPU path on a small `room`: every
+/// `wgsl::SH_HVL_SUM`, shadow rays in `f32`, the direct light by `wgsl::LOBE_CHAIN`) against
+/// the CPU path on a small `room`: every
 /// pixel within `SH_HVL_SUM_TOL` of its largest channel, except where a shadow ray between
 /// a receiver and an HVL grazing an occluder flips between `f32` and `f64`: at most 0.5 %
 /// of the lit pixels, each within 2e-3 (the test prints the counts).

@@ -424,7 +424,9 @@ fn hvl_settings<'a>(
     );
     if let Some(gpu) = gpu {
         variants.push(Setting {
-            label: format!("{hvls} HVLs, every pixel, wgpu (diffuse indirect on the adapter)"),
+            label: format!(
+                "{hvls} HVLs, every pixel, wgpu (direct and diffuse indirect on the adapter)"
+            ),
             render: Box::new(move || {
                 let blank =
                     || Image::new(scene.camera.width as usize, scene.camera.height as usize);

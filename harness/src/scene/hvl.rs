@@ -37,7 +37,7 @@ use steradian_core::lobe::sum::ProductCounts;
 use steradian_core::sh::{brdf, hvl as core_hvl};
 
 use super::image::Image;
-use super::{Kind, Ray, Rgb, Scene, ShadingPoint, Shape, lattice, lobes, path, render_centres};
+use super::{Kind, Ray, Rgb, Scene, ShadingPoint, Shape, lattice, lobes, path};
 
 /// Settings of the `hvl` method.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -659,8 +659,10 @@ fn gpu_sum_table(scene: &Scene, hvls: &[Placed], bands: usize, visibility: bool)
     t
 }
 
-/// [`render`] with the diffuse indirect light on the wgpu backend: the direct light and the
-/// receivers' glossy parts on the CPU as [`render`] computes them, and each receiver's
+/// [`render`] with the diffuse indirect light and the direct light on the wgpu backend: the
+/// direct light by the `lobes` method's wgpu path ([`lobes::render_gpu`], within
+/// `steradian_core::wgsl::LOBE_CHAIN_REL_TOL` of its scalar path), the receivers' glossy
+/// parts on the CPU as [`render`] computes them, and each receiver's
 /// diffuse sum over the HVLs by `steradian_core::wgsl::SH_HVL_SUM` ([`GPU_BATCH`] receivers
 /// per dispatch, the shadow rays against the scene's spheres and planes in `f32` from the
 /// CPU path's origin, skipping the object the HVL lies on: in `f32` a ray grazing a plane
@@ -685,12 +687,22 @@ pub fn render_gpu(
     let hvls = &at.placed;
     let nb = o.bands.clamp(1, brdf::lambert().bands());
     let table = gpu_sum_table(scene, hvls, nb, o.visibility);
-    let new_state = || (ProductCounts::default(), Scratch::default());
-    let (mut img, _) = render_centres(scene, bar, new_state, |(counts, scratch), p| {
-        let d = lobes::shade(scene, p, &o.direct, counts);
-        let g = indirect_parts(scene, p, &at, o, &views, false, scratch);
-        [d[0] + g[0], d[1] + g[1], d[2] + g[2]]
-    });
+    // The direct light by the `lobes` method's wgpu path, the glossy indirect parts on the
+    // CPU beside it.
+    let (direct, _) = lobes::render_gpu(scene, &o.direct, gpu, &ProgressBar::hidden())?;
+    let width = scene.camera.width as usize;
+    let (mut img, _) = super::render_centres_x8_at(
+        scene,
+        bar,
+        Scratch::default,
+        |scratch, pixels, points, out| {
+            for ((&(i, j), p), o_k) in pixels.iter().zip(points).zip(out.iter_mut()) {
+                let d = direct.data[j * width + i];
+                let g = indirect_parts(scene, p, &at, o, &views, false, scratch);
+                *o_k = [d[0] + g[0], d[1] + g[1], d[2] + g[2]];
+            }
+        },
+    );
     // The receivers with a diffuse part: pixel, albedo and the kernel's input row.
     let cam = scene.camera;
     let (w, h) = (cam.width as usize, cam.height as usize);

@@ -406,7 +406,8 @@ pub fn plan(scene: &Scene, o: &Options) -> Result<Plan, String> {
                     value: json!(kernel_name(o)),
                     reason: if o.gpu {
                         "--gpu: the diffuse indirect light by the WGSL HVL sum, one receiver \
-                         per invocation; the direct light and glossy parts on the CPU"
+                         per invocation, and the direct light by the lobes wgpu path; the glossy \
+                         parts on the CPU"
                             .into()
                     } else if o.scalar {
                         "--scalar: every HVL by the scalar kernels, one at a time".into()
