@@ -18,6 +18,7 @@
 
 pub mod builtin;
 pub mod file;
+pub mod footprint;
 pub mod geom;
 pub mod hvl;
 pub mod image;

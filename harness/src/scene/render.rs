@@ -239,6 +239,20 @@ pub fn plan(scene: &Scene, o: &Options) -> Result<Plan, String> {
                     super::unshadowed::MAX_EXPONENT
                 ),
             });
+            r.footprint = super::footprint::PLAN_FACTOR * o.target_error;
+            p.push(PlanItem {
+                item: "footprint".into(),
+                value: json!(r.footprint),
+                reason: format!(
+                    "pixels whose centre alone is estimated to miss the pixel's mean (the path \
+                     tracer's box filter) by {} times the target {} of the maximum or more, from \
+                     the image's Laplacian over neighbours on the same object (|Δf|/24), are \
+                     re-shaded at the 2×2 Gauss–Legendre points of the pixel and averaged: the \
+                     sun's glossy highlight and sharp shadow edges",
+                    super::footprint::PLAN_FACTOR,
+                    o.target_error
+                ),
+            });
             p.push(PlanItem {
                 item: "brdf_sats".into(),
                 value: json!(r.sat_target),

@@ -40,7 +40,7 @@ use steradian_core::rsl::visibility::{Outside, coverage_into_depth, local_cap};
 use super::image::Image;
 use super::material::{Material, reflect};
 use super::unshadowed::EnvTables;
-use super::{Rgb, Scene, Seen, ShadingPoint, Shape, render_centres};
+use super::{Rgb, Scene, Seen, ShadingPoint, Shape, footprint, render_centres};
 use crate::env::Equirect;
 use crate::env::decompose::{Decomposition, decompose};
 
@@ -64,6 +64,11 @@ pub struct Options {
     /// every occluder to its value under the planes alone (both over the same squares),
     /// instead of `S` alone. Off, the method is the paper's pipeline.
     pub exact_unshadowed: bool,
+    /// The footprint threshold of [`super::footprint::refine`], relative to the image's
+    /// largest value: the pixels whose centre alone is estimated to miss the pixel's mean
+    /// by that much are re-shaded at four points. 0 (the default, the paper): pixel
+    /// centres only; `steradian render` plans its target error.
+    pub footprint: f64,
 }
 
 impl Default for Options {
@@ -75,6 +80,7 @@ impl Default for Options {
             sat_target: 0.005,
             vis_depth: coverage_depth_for(super::DEFAULT_TARGET_ERROR),
             exact_unshadowed: true,
+            footprint: 0.0,
         }
     }
 }
@@ -887,23 +893,19 @@ pub fn render_built_simd(
     };
     let cam = scene.camera;
     let (w, h) = (cam.width as usize, cam.height as usize);
-    let rows: Vec<Result<Vec<Rgb>, String>> = (0..h)
-        .into_par_iter()
-        .map(|j| {
-            let mut cov = vec![0.0f32; o.vis_side * o.vis_side];
-            let mut row = vec![[0.0; 3]; w];
-            // (pixel, point, frame, tables) of the row's shaded points.
-            let mut pts = Vec::with_capacity(w);
-            for (i, px) in row.iter_mut().enumerate() {
-                match scene.see(&cam.centre_ray(i as u32, j as u32)) {
-                    Seen::Radiance(l) => *px = l,
-                    Seen::Surface(p) => {
-                        if let Some((frame, m, base)) = point_vis(scene, o, &p, &mut cov) {
-                            pts.push((i, p, frame, m, base));
-                        }
-                    }
-                }
+    // The radiance of surface points (0 where no visibility tables are built), eight at a
+    // time.
+    let shade_points = |surface: &[ShadingPoint]| -> Result<Vec<Rgb>, String> {
+        let mut cov = vec![0.0f32; o.vis_side * o.vis_side];
+        let mut radiance = vec![[0.0; 3]; surface.len()];
+        // (index, point, frame, tables) of the shaded points.
+        let mut pts = Vec::with_capacity(surface.len());
+        for (i, p) in surface.iter().enumerate() {
+            if let Some((frame, m, base)) = point_vis(scene, o, p, &mut cov) {
+                pts.push((i, *p, frame, m, base));
             }
+        }
+        {
             let points: Vec<ShadingPoint> = pts.iter().map(|p| p.1).collect();
             let mut batch = |key: Option<SpecKey>, sel: &[usize], pair: bool| {
                 let tables = match key {
@@ -996,7 +998,27 @@ pub fn render_built_simd(
             };
             let shaded = shade_by_part(scene, built, &points, &mut batch)?;
             for ((i, _, _, _, _), v) in pts.iter().zip(shaded) {
-                row[*i] = v;
+                radiance[*i] = v;
+            }
+        }
+        Ok(radiance)
+    };
+    let rows: Vec<Result<Vec<Rgb>, String>> = (0..h)
+        .into_par_iter()
+        .map(|j| {
+            let mut row = vec![[0.0; 3]; w];
+            let (mut at, mut surface) = (Vec::with_capacity(w), Vec::with_capacity(w));
+            for (i, px) in row.iter_mut().enumerate() {
+                match scene.see(&cam.centre_ray(i as u32, j as u32)) {
+                    Seen::Radiance(l) => *px = l,
+                    Seen::Surface(p) => {
+                        at.push(i);
+                        surface.push(p);
+                    }
+                }
+            }
+            for (i, v) in at.into_iter().zip(shade_points(&surface)?) {
+                row[i] = v;
             }
             bar.inc(1);
             Ok(row)
@@ -1006,6 +1028,13 @@ pub fn render_built_simd(
     for (j, row) in rows.into_iter().enumerate() {
         img.data[j * w..(j + 1) * w].copy_from_slice(&row?);
     }
+    footprint::refine(scene, &mut img, o.footprint, |points| {
+        let parts = points
+            .par_chunks(w.max(8))
+            .map(shade_points)
+            .collect::<Result<Vec<_>, String>>()?;
+        Ok(parts.concat())
+    })?;
     Ok(img)
 }
 
@@ -1024,10 +1053,17 @@ pub fn render_built(
     o: &Options,
     bar: &ProgressBar,
 ) -> Result<Image, String> {
+    use rayon::prelude::*;
     let new_cov = || vec![0.0f32; o.vis_side * o.vis_side];
-    let (img, _) = render_centres(scene, bar, new_cov, |cov, p| {
+    let (mut img, _) = render_centres(scene, bar, new_cov, |cov, p| {
         shade_point(scene, built, o, p, cov)
     });
+    footprint::refine(scene, &mut img, o.footprint, |points| {
+        Ok(points
+            .par_iter()
+            .map_init(new_cov, |cov, p| shade_point(scene, built, o, p, cov))
+            .collect())
+    })?;
     Ok(img)
 }
 
@@ -1048,10 +1084,6 @@ pub fn render_built_gpu(
     gpu: &mut crate::backend::gpu::Gpu,
     bar: &ProgressBar,
 ) -> Result<Image, String> {
-    use crate::shade::{GPU_MOMENTS_MAX_TABLE_BYTES, ShadePoint, shade_moments_gpu_at};
-    use rayon::prelude::*;
-
-    let free = free_moments(o)?;
     let cam = scene.camera;
     let (w, h) = (cam.width as usize, cam.height as usize);
     let mut img = Image::new(w, h);
@@ -1066,6 +1098,34 @@ pub fn render_built_gpu(
             }
         }
     }
+    let points: Vec<ShadingPoint> = queue.iter().map(|q| q.1).collect();
+    let shaded = shade_points_gpu(scene, built, o, gpu, &points, bar)?;
+    for ((k, _), v) in queue.iter().zip(shaded) {
+        img.data[*k] = v;
+    }
+    bar.set_position((w * h) as u64);
+    footprint::refine(scene, &mut img, o.footprint, |points| {
+        shade_points_gpu(scene, built, o, gpu, points, &ProgressBar::hidden())
+    })?;
+    Ok(img)
+}
+
+/// The radiance of surface points by [`render_built_gpu`]'s kernels, [`GPU_BATCH`] at a
+/// time (0 where no visibility tables are built); `bar` advances by each batch.
+fn shade_points_gpu(
+    scene: &Scene,
+    built: &Built,
+    o: &Options,
+    gpu: &mut crate::backend::gpu::Gpu,
+    surface: &[ShadingPoint],
+    bar: &ProgressBar,
+) -> Result<Vec<Rgb>, String> {
+    use crate::shade::{GPU_MOMENTS_MAX_TABLE_BYTES, ShadePoint, shade_moments_gpu_at};
+    use rayon::prelude::*;
+
+    let free = free_moments(o)?;
+    let mut radiance = vec![[0.0; 3]; surface.len()];
+    let queue: Vec<(usize, ShadingPoint)> = surface.iter().copied().enumerate().collect();
     for chunk in queue.chunks(GPU_BATCH) {
         let tables: Vec<Option<(Frame, VisMoments, Base)>> = chunk
             .par_iter()
@@ -1149,10 +1209,9 @@ pub fn render_built_gpu(
         };
         let shaded = shade_by_part(scene, built, &points, &mut batch)?;
         for (&(k, _), v) in px.iter().zip(shaded) {
-            img.data[k] = v;
+            radiance[k] = v;
         }
         bar.inc(chunk.len() as u64);
     }
-    bar.set_position((w * h) as u64);
-    Ok(img)
+    Ok(radiance)
 }
