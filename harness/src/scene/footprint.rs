@@ -64,8 +64,8 @@ pub fn footprint_estimates(scene: &Scene, img: &Image) -> Vec<Option<f64>> {
             for n in near.into_iter().flatten() {
                 if objects[n] == Some(own) {
                     count += 1;
-                    for c in 0..3 {
-                        sum[c] += img.data[n][c] - img.data[k][c];
+                    for (c, v) in sum.iter_mut().enumerate() {
+                        *v += img.data[n][c] - img.data[k][c];
                     }
                 }
             }
