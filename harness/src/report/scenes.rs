@@ -168,18 +168,24 @@ fn path_seconds_at(curve: &[Point], err: f64, m: fn(&Metrics) -> f64) -> Option<
     Some((t_end - 2.0 * (e - e_end)).exp())
 }
 
-/// The two measures the equal-error cost is read on.
+/// The three measures the equal-error cost is read on, one per paper: mean |difference|
+/// over the maximum (the cosine-lobe paper's), noise-corrected relative L2 (the RSL
+/// paper's) and the RMSE of the tone-mapped images (the HVL paper's).
 fn mean_abs(m: &Metrics) -> f64 {
     m.mean_abs_over_max
 }
 fn rel_l2_corrected(m: &Metrics) -> f64 {
     m.rel_l2_noise_corrected
 }
+fn rmse(m: &Metrics) -> f64 {
+    m.rmse
+}
 
-/// The path tracer's time at a point's error over the point's time, on both measures.
-fn cost_ratios(path: &[Point], p: &Point) -> (Option<f64>, Option<f64>) {
+/// The path tracer's time at a point's error over the point's time, on each measure:
+/// `[mean |diff|, noise-corrected rel L2, RMSE]`.
+fn cost_ratios(path: &[Point], p: &Point) -> [Option<f64>; 3] {
     let r = |m: fn(&Metrics) -> f64| path_seconds_at(path, m(&p.metrics), m).map(|t| t / p.seconds);
-    (r(mean_abs), r(rel_l2_corrected))
+    [r(mean_abs), r(rel_l2_corrected), r(rmse)]
 }
 
 /// A method's render under one setting: the image and its kernel products per pixel.
@@ -634,7 +640,7 @@ fn measure_scene(
     }
     bar.inc(1);
     let (default, dp, dimg) = default_img.ok_or("the default setting is on the curve")?;
-    let equal_error_ratio = cost_ratios(&path_curve, &dp).0.unwrap_or(f64::NAN);
+    let equal_error_ratio = cost_ratios(&path_curve, &dp)[0].unwrap_or(f64::NAN);
     let diff = metrics::difference_image(
         &class,
         &dimg,
@@ -664,6 +670,11 @@ fn measure_scene(
     })
 }
 
+/// `12.3×`, or `–` where the ratio is not defined.
+fn ratio_text(r: Option<f64>) -> String {
+    r.map_or("–".to_string(), |v| format!("{v:.1}×"))
+}
+
 fn point_json(p: &Point) -> serde_json::Value {
     json!({
         "setting": p.setting,
@@ -676,10 +687,11 @@ fn point_json(p: &Point) -> serde_json::Value {
 
 /// A method's point with its equal-error cost ratios against the path tracer's curve.
 fn method_point_json(path: &[Point], p: &Point) -> serde_json::Value {
-    let (a, l2) = cost_ratios(path, p);
+    let [a, l2, rmse] = cost_ratios(path, p);
     let mut v = point_json(p);
     v["equal_error_cost_ratio"] = json!(a);
     v["equal_error_cost_ratio_rel_l2"] = json!(l2);
+    v["equal_error_cost_ratio_rmse"] = json!(rmse);
     v
 }
 
@@ -747,11 +759,12 @@ pub fn section(opts: &Options) -> Result<Section, Box<dyn Error>> {
             .collect();
         writeln!(
             summary,
-            "  {} ({}, {} bounce(s)): {:.2e} of max radiance, RMSE {:.4}, in {:.1} ms ({}); path tracer {:.2e} at {} spp, {:.2e} at {} spp; reference noise {:.1e}; equal-error cost ratio {:.1}×",
+            "  {} ({}, {} bounce(s)): {:.2e} of max radiance, noise-corrected rel L2 {:.4}, RMSE {:.4}, in {:.1} ms ({}); path tracer {:.2e} at {} spp, {:.2e} at {} spp; reference noise {:.1e}; equal-error cost ratio {:.1}× (on noise-corrected rel L2 {}, on RMSE {})",
             r.name,
             r.method,
             r.bounces,
             d.metrics.mean_abs_over_max,
+            d.metrics.rel_l2_noise_corrected,
             d.metrics.rmse,
             d.seconds * 1e3,
             if variants.is_empty() {
@@ -764,24 +777,24 @@ pub fn section(opts: &Options) -> Result<Section, Box<dyn Error>> {
             r.path[r.path.len() - 1].metrics.mean_abs_over_max,
             PATH_SPP[PATH_SPP.len() - 1],
             d.metrics.reference_noise_over_max,
-            r.equal_error_ratio
+            r.equal_error_ratio,
+            ratio_text(cost_ratios(&r.path, d)[1]),
+            ratio_text(cost_ratios(&r.path, d)[2])
         )?;
         // The best equal-error cost over the method's curve, on each measure.
         let best = |k: usize| {
             r.curve
                 .iter()
-                .filter_map(|p| {
-                    let c = cost_ratios(&r.path, p);
-                    [c.0, c.1][k].map(|v| (v, p.setting.as_str()))
-                })
+                .filter_map(|p| cost_ratios(&r.path, p)[k].map(|v| (v, p.setting.as_str())))
                 .max_by(|a, b| a.0.total_cmp(&b.0))
                 .map_or("–".to_string(), |(v, s)| format!("{v:.1}× ({s})"))
         };
         writeln!(
             summary,
-            "    best equal-error cost ratio over the curve: {} on mean |diff|, {} on noise-corrected rel L2",
+            "    best equal-error cost ratio over the curve: {} on mean |diff|, {} on noise-corrected rel L2, {} on RMSE",
             best(0),
-            best(1)
+            best(1),
+            best(2)
         )?;
         let per_core: Vec<String> = r
             .per_core
