@@ -619,15 +619,11 @@ fn rsl_at_k_30_is_within_the_rsl_papers_figure_against_the_report_reference() {
     use steradian_harness::report::scenes::{ENVIRONMENT_REFERENCE_SPP, WIDTH};
     use steradian_harness::scene::rsl;
     let small = Small::new("environment", WIDTH, ENVIRONMENT_REFERENCE_SPP, 0);
-    let planned = render::plan(
+    let planned = plan_at(
         &small.scene,
-        &render::Options {
-            method: render::Method::Rsl,
-            quiet: true,
-            ..render::Options::default()
-        },
+        render::Method::Rsl,
+        scene::DEFAULT_TARGET_ERROR,
     )
-    .unwrap()
     .rsl;
     let o = rsl::Options { k: 30, ..planned };
     let built = rsl::build(&small.scene, &o).unwrap();
@@ -823,16 +819,7 @@ fn rsl_against_the_exact_integral_on_environment() {
         }
         sums.map(|[e2, r2]| (e2 / r2).sqrt())
     };
-    let planned = render::plan(
-        &s,
-        &render::Options {
-            method: render::Method::Rsl,
-            quiet: true,
-            ..render::Options::default()
-        },
-    )
-    .unwrap()
-    .rsl;
+    let planned = plan_at(&s, render::Method::Rsl, scene::DEFAULT_TARGET_ERROR).rsl;
     let render = |exact_unshadowed: bool| {
         // Pixel centres against pixel centres: no footprint refinement.
         let o = rsl::Options {

@@ -667,25 +667,14 @@ pub fn render_gpu(
     gpu: &mut crate::backend::gpu::Gpu,
     bar: &ProgressBar,
 ) -> Result<(Image, ProductCounts), String> {
-    use super::Seen;
     use crate::backend::gpu::Custom;
     use crate::kernels::Columns;
     use rayon::prelude::*;
 
-    let cam = scene.camera;
-    let (w, h) = (cam.width as usize, cam.height as usize);
-    let mut img = Image::new(w, h);
-    let mut queue = Vec::new();
-    bar.set_length((w * h) as u64);
-    for j in 0..h {
-        for i in 0..w {
-            match scene.see(&cam.centre_ray(i as u32, j as u32)) {
-                Seen::Radiance(l) => img.data[j * w + i] = l,
-                Seen::Surface(p) => queue.push((j * w + i, p)),
-            }
-        }
-    }
-    bar.inc((w * h - queue.len()) as u64);
+    let (mut img, queue) = super::centre_queue(scene);
+    let pixels = img.data.len();
+    bar.set_length(pixels as u64);
+    bar.inc((pixels - queue.len()) as u64);
     let product_table = o.table.table().gpu_table();
     let mut counts = ProductCounts::default();
     for chunk in queue.chunks(GPU_BATCH) {

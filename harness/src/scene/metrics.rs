@@ -12,7 +12,8 @@
 //! - `rel_l2` (rotatable-square-lights paper): `‖method − reference‖₂ / ‖reference‖₂` over
 //!   shaded pixels;
 //! - `rmse`, `psnr_db` (HVL paper): over the whole image, on tone-mapped values in
-//!   `[0, 1]` (`srgb(v·2^exposure)`), PSNR `= −20·log10(rmse)`;
+//!   `[0, 1]` (`srgb(v·2^exposure)`), PSNR `= −20·log10(rmse)`; `rmse_shaded` the same
+//!   over shaded pixels only (silhouettes apart, as for the other measures);
 //! - `ssim`: over the whole 8-bit tone-mapped image, by `image-compare`'s SSIM (8 × 8
 //!   windows, the smallest of the three channels' means);
 //! - `rel_l2_noise_corrected`: `rel_l2` with the reference's noise taken out. For an image
@@ -68,6 +69,8 @@ pub struct Metrics {
     pub rel_l2_noise_corrected: f64,
     /// RMSE of the tone-mapped images, whole image.
     pub rmse: f64,
+    /// RMSE of the tone-mapped images over shaded pixels.
+    pub rmse_shaded: f64,
     /// PSNR in dB of the tone-mapped images.
     pub psnr_db: f64,
     /// SSIM of the 8-bit tone-mapped images.
@@ -155,6 +158,18 @@ pub fn compare(
         .sum::<f64>()
         / (3 * ta.len()).max(1) as f64;
     let rmse = mse.sqrt();
+    let (mut se_shaded, mut n_se) = (0.0, 0usize);
+    for ((p, q), c) in ta.iter().zip(&tb).zip(class) {
+        if *c == Some(true) {
+            se_shaded += (0..3).map(|ch| (p[ch] - q[ch]).powi(2)).sum::<f64>();
+            n_se += 3;
+        }
+    }
+    let rmse_shaded = if n_se == 0 {
+        0.0
+    } else {
+        (se_shaded / n_se as f64).sqrt()
+    };
     let ssim = if img.width >= 8 && img.height >= 8 {
         image_compare::rgb_similarity_structure(
             &image_compare::Algorithm::MSSIMSimple,
@@ -177,6 +192,7 @@ pub fn compare(
             0.0
         },
         rmse,
+        rmse_shaded,
         psnr_db: if rmse > 0.0 {
             -20.0 * rmse.log10()
         } else {

@@ -333,6 +333,25 @@ pub fn render_centres<S: Send>(
     })
 }
 
+/// Every pixel's centre ray, for the paths that shade in batches of their own (the wgpu
+/// paths): the image with what the camera sees where it is not a surface (lights, the
+/// environment), and the surface points queued with their pixel index (row-major).
+pub fn centre_queue(scene: &Scene) -> (Image, Vec<(usize, ShadingPoint)>) {
+    let cam = scene.camera;
+    let (w, h) = (cam.width as usize, cam.height as usize);
+    let mut img = Image::new(w, h);
+    let mut queue = Vec::new();
+    for j in 0..h {
+        for i in 0..w {
+            match scene.see(&cam.centre_ray(i as u32, j as u32)) {
+                Seen::Radiance(l) => img.data[j * w + i] = l,
+                Seen::Surface(p) => queue.push((j * w + i, p)),
+            }
+        }
+    }
+    (img, queue)
+}
+
 /// [`render_centres`] with the surface points of a row shaded eight at a time by
 /// `shade(state, points, out)` (`out[k]` for `points[k]`; the last batch of a row may be
 /// shorter).

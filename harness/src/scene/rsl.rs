@@ -1084,26 +1084,14 @@ pub fn render_built_gpu(
     gpu: &mut crate::backend::gpu::Gpu,
     bar: &ProgressBar,
 ) -> Result<Image, String> {
-    let cam = scene.camera;
-    let (w, h) = (cam.width as usize, cam.height as usize);
-    let mut img = Image::new(w, h);
-    // Every pixel's centre: lights and the environment as seen, surface points queued.
-    let mut queue = Vec::new();
-    bar.set_length((w * h) as u64);
-    for j in 0..h {
-        for i in 0..w {
-            match scene.see(&cam.centre_ray(i as u32, j as u32)) {
-                Seen::Radiance(l) => img.data[j * w + i] = l,
-                Seen::Surface(p) => queue.push((j * w + i, p)),
-            }
-        }
-    }
+    let (mut img, queue) = super::centre_queue(scene);
+    bar.set_length(img.data.len() as u64);
     let points: Vec<ShadingPoint> = queue.iter().map(|q| q.1).collect();
     let shaded = shade_points_gpu(scene, built, o, gpu, &points, bar)?;
     for ((k, _), v) in queue.iter().zip(shaded) {
         img.data[*k] = v;
     }
-    bar.set_position((w * h) as u64);
+    bar.set_position(img.data.len() as u64);
     footprint::refine(scene, &mut img, o.footprint, |points| {
         shade_points_gpu(scene, built, o, gpu, points, &ProgressBar::hidden())
     })?;
