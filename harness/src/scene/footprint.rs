@@ -157,6 +157,62 @@ pub fn refine(
 mod tests {
     use super::*;
 
+    /// The contract of [`refine`] on a small `lobes` scene: a flat image re-shades nothing
+    /// (the shading closure is not called), nor does a threshold that is not positive; a
+    /// step across the image re-shades exactly the surface pixels beside it whose
+    /// estimate reaches the threshold, four points each (fewer where a point sees no
+    /// surface), and each takes the mean of its four; a closure that answers another
+    /// count is an error.
+    #[test]
+    fn refine_reshades_only_where_the_estimate_reaches_the_threshold() {
+        let mut scene = Scene::load("builtin:lobes").unwrap();
+        scene.camera = scene.camera.resized(24).unwrap();
+        let (w, h) = (scene.camera.width as usize, scene.camera.height as usize);
+        let flat = |v: f64| {
+            let mut img = Image::new(w, h);
+            img.data.iter_mut().for_each(|p| *p = [v; 3]);
+            img
+        };
+        let never = |_: &[ShadingPoint]| -> Result<Vec<Rgb>, String> {
+            panic!("nothing should be re-shaded")
+        };
+        assert_eq!(refine(&scene, &mut flat(1.0), 1e-3, never), Ok(0));
+        // A step between columns 11 and 12.
+        let mut step = flat(1.0);
+        for (k, p) in step.data.iter_mut().enumerate() {
+            if k % w >= 12 {
+                *p = [2.0; 3];
+            }
+        }
+        assert_eq!(refine(&scene, &mut step.clone(), 0.0, never), Ok(0));
+        assert_eq!(refine(&scene, &mut step.clone(), -1.0, never), Ok(0));
+        let est = footprint_estimates(&scene, &step);
+        let want: Vec<usize> = (0..w * h)
+            .filter(|&k| est[k].is_some_and(|e| e >= 0.01 * 2.0))
+            .collect();
+        assert!(!want.is_empty());
+        assert!(want.iter().all(|&k| k % w == 11 || k % w == 12), "{want:?}");
+        let mut refined = step.clone();
+        let mut given = 0;
+        let n = refine(&scene, &mut refined, 0.01, |pts| {
+            given = pts.len();
+            Ok(vec![[8.0; 3]; pts.len()])
+        })
+        .unwrap();
+        assert_eq!(n, want.len());
+        assert!(given <= 4 * n && given > 0, "{given} points for {n} pixels");
+        for k in 0..w * h {
+            if want.contains(&k) {
+                // The mean of four values, each 8 or what a point sees off the surfaces.
+                assert_ne!(refined.data[k], step.data[k], "pixel {k}");
+            } else {
+                assert_eq!(refined.data[k], step.data[k], "pixel {k}");
+            }
+        }
+        let short = refine(&scene, &mut step.clone(), 0.01, |_| Ok(Vec::new()));
+        assert!(short.is_err());
+    }
+
     /// The 2×2 Gauss–Legendre mean is the unit box's mean of every monomial `x^a·y^b` with
     /// `a, b ≤ 3` (`1/((a + 1)(b + 1))`), and not of `x⁴` (degree 4 is past its exactness).
     #[test]
