@@ -98,7 +98,7 @@ enum Command {
         /// time with SIMD kernels, and hvl sums each receiver's HVLs with them).
         #[arg(long)]
         scalar: bool,
-        /// Shade on the wgpu backend (rsl; hvl its diffuse indirect light; an error without an adapter).
+        /// Shade on the wgpu backend (lobes and rsl; hvl its direct and diffuse indirect light; an error without an adapter).
         #[arg(long, conflicts_with = "scalar")]
         gpu: bool,
     },
