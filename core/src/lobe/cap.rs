@@ -294,7 +294,10 @@ impl SphericalCap {
             return f32::NAN;
         }
         let (n, a) = (n.as_dvec3(), self.axis.as_dvec3());
-        let (cos_t, sin_t) = (n.dot(a), n.cross(a).length());
+        // Clamped: an `f32` unit normal may be an ulp or so longer than 1, and a cosine past
+        // ±1 would push the value out of `[0, π]` (past the top of a cap, below 0 beneath a
+        // cap wider than a hemisphere).
+        let (cos_t, sin_t) = (n.dot(a).clamp(-1.0, 1.0), n.cross(a).length());
         let omc = f64::from(self.one_minus_cos);
         let s2 = omc * (2.0 - omc);
         let pi = core::f64::consts::PI;
@@ -315,7 +318,7 @@ impl SphericalCap {
         let v = if omc <= 1.0 {
             clipped(cos_t, 1.0 - omc)
         } else {
-            pi - clipped(-cos_t, omc - 1.0)
+            (pi - clipped(-cos_t, omc - 1.0)).max(0.0)
         };
         v as f32
     }
@@ -505,6 +508,21 @@ mod tests {
             sum += ring * t.sin() * h;
         }
         sum
+    }
+
+    /// A normal an `f32` ulp or so longer than 1 (as `normalize` may leave it) stays within
+    /// `[0, π s²]`: straight below a cap one ulp wider than a hemisphere (the fuzz target
+    /// `cap_integrals` found −1.5e-6 there, from a cosine of −1.0000005) and straight above
+    /// a hemisphere.
+    #[test]
+    fn clipped_cosine_of_a_slightly_long_normal_stays_in_range() {
+        let wide = SphericalCap::new(Vec3::X, 1.570_796_8).unwrap();
+        assert!(wide.one_minus_cos() > 1.0);
+        let below = wide.clipped_cosine(Vec3::new(-1.000_000_5, 0.0, 0.0));
+        assert!((0.0..1e-6).contains(&below), "{below}");
+        let half = SphericalCap::new(Vec3::X, core::f32::consts::FRAC_PI_2).unwrap();
+        let above = half.clipped_cosine(Vec3::new(1.000_000_5, 0.0, 0.0));
+        assert!(above <= crate::PI && above > 3.14, "{above}");
     }
 
     #[test]
