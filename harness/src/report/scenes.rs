@@ -55,9 +55,9 @@ pub const REFERENCE_SPP: u32 = 2048;
 /// direct-light scenes'.
 pub const ROOM_REFERENCE_SPP: u32 = 4096;
 /// Samples per pixel of the `environment` reference, the noisiest per sample (a sun in
-/// the environment and a glossy sphere): at 4096 its noise (4.3e-3 of the maximum) was
-/// larger than the `rsl` method's mean |difference| from the exact integral (1.2e-3), so
-/// that measure read the reference, not the method.
+/// the environment and a glossy sphere): at 4096 its noise was larger than the `rsl`
+/// method's own mean |difference|, so that measure read the reference, not the method
+/// (each point reports `reference_noise_over_max` beside its errors).
 pub const ENVIRONMENT_REFERENCE_SPP: u32 = 16384;
 
 /// The reference's samples per pixel for a scene.

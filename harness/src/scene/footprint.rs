@@ -17,11 +17,7 @@
 //!
 //! The `rsl` method plans `threshold` as [`PLAN_FACTOR`] times its target error (the
 //! render's mean |difference| over the maximum radiance): a pixel is re-shaded where its
-//! centre alone is estimated to miss the pixel's mean by more than that. On `environment`
-//! at 96 columns against the exact box means (1024 × 512 directions per Gauss point, a
-//! one-off measurement), twice the default target brings the relative L2 from 0.40 % to
-//! 0.35 % at 1.22× the SIMD render's time (123 → 150 ms); the target itself re-shades
-//! 6.1 % of the surface pixels for 0.34 % at 1.44× (177 ms). The harness test
+//! centre alone is estimated to miss the pixel's mean by more than that. The harness test
 //! `rsl_method_against_the_path_tracer_on_a_small_environment_scene` asserts the gain
 //! against the path tracer.
 
@@ -30,7 +26,9 @@ use rayon::prelude::*;
 use super::image::Image;
 use super::{Rgb, Scene, Seen, ShadingPoint};
 
-/// The footprint threshold a method plans, in units of its target error (module docs).
+/// The footprint threshold a method plans, in units of its target error (module docs):
+/// twice the target re-shades about half the pixels the target itself would on
+/// `environment`, for nearly the same error against the box means.
 pub const PLAN_FACTOR: f64 = 2.0;
 
 /// The 2×2 Gauss–Legendre points of the unit interval, `½ ± 1/(2√3)` (weights ½ each).
