@@ -63,6 +63,8 @@ shim! {
     cbrt64(f64) => cbrt, cbrt;
     sin64(f64) => sin, sin;
     cos64(f64) => cos, cos;
+    expm1_64(f64) => exp_m1, expm1;
+    log1p_64(f64) => ln_1p, log1p;
     atan2_64(f64, x2) => atan2, atan2;
     floor64(f64) => floor, floor;
 }

@@ -21,13 +21,20 @@
 //! [`EXCESS_L2_REL`] relative, `J(e)/J(e*) − 1 ≤ EXCESS_L2_REL` (so the L2 error itself is
 //! within half of that).
 //!
-//! **Which fit.** [`CapFit::L2`] keeps the shape of the cap best and is the right lobe
-//! when the cap is multiplied by lobes of similar or smaller width (glossy highlights,
-//! occluders); its integral `2π/(e+1)` overestimates the cap's solid angle (by 4 % for small
-//! caps, up to 2× near a hemisphere). [`CapFit::EnergyPreserving`] keeps the same exponent and
-//! rescales so the lobe integral equals the solid angle `2π(1 − cos α)`: the better choice
-//! when the light is small against the BRDF lobe (diffuse and rough surfaces), where only
-//! the total power reaching the point matters.
+//! **Which fit.** [`CapFit::L2`] keeps the shape of the cap best pointwise; its integral
+//! `2π/(e+1)` overestimates the cap's solid angle (by 4 % for small caps, up to 2× near a
+//! hemisphere). [`CapFit::EnergyPreserving`] keeps the same exponent and rescales so the
+//! lobe integral equals the solid angle `2π(1 − cos α)`: where only the total power
+//! reaching the point matters (the cosine, occluders' visible fractions). Both lobes are
+//! wider than the cap: for small caps the L2 lobe's angular variance is `α²/0.96` against
+//! the cap's `α²/2`. So a product with a lobe narrower than ~`2/α²` is blurred: a Phong
+//! highlight of the light comes out too low at its centre and too bright around it.
+//! [`CapFit::Moments`] matches the cap's solid angle *and* its mean cosine in closed form
+//! (no table): its product with any lobe about the cap's axis is exact to second order in
+//! `x = n(1 − cos α)` (`n` that lobe's exponent), so it is the lobe for products with
+//! glossy lobes as long as `x` stays small ([`moments_lobe_relative_error`] gives the
+//! error on the axis for every `x`; [`MOMENTS_MAX_X`] is where the energy-preserving lobe
+//! becomes the better one).
 
 use crate::frame::{check_dir, normalize_or_zero};
 use crate::lobe::CosineLobe;
@@ -117,6 +124,34 @@ pub enum CapFit {
     L2,
     /// Same exponent, scale chosen so the lobe integral equals the cap's solid angle.
     EnergyPreserving,
+    /// The cap's solid angle and mean cosine, in closed form: `e = 2c/(1 − c)`, scale
+    /// `1 + c` (`c = cos α`). From `∫ s·(a·ω)^e dω = 2πs/(e + 1) = 2π(1 − c)` and
+    /// `∫ s·(a·ω)^(e+1) dω = 2πs/(e + 2) = π(1 − c²)`. Exact for the hemisphere (`e = 0`,
+    /// scale 1); for small caps `e ≈ 4/α²`, the cap's angular variance `α²/2`. A cap
+    /// wider than a hemisphere (`c < 0`) gets `e = 0` and scale `1 − c` (solid angle only).
+    Moments,
+}
+
+/// Where [`CapFit::Moments`] stops being the better lobe for a product with a lobe of
+/// exponent `n` about the cap's axis: above `x = n(1 − cos α) = 2.7` the
+/// energy-preserving lobe's error on the axis is the smaller (small-cap limit of
+/// [`moments_lobe_relative_error`] against the same for the energy-preserving lobe; test
+/// `moments_fit_against_energy_preserving_on_the_axis`).
+pub const MOMENTS_MAX_X: f32 = 2.7;
+
+/// Relative error of the [`CapFit::Moments`] lobe's product with a unit lobe of exponent
+/// `n` about the cap's axis, against the exact `∫_cap (a·ω)^n dω = 2π(1 − c^(n+1))/(n+1)`:
+/// the lobe gives `2π(1 + c)/(e + n + 1)`. In the small-cap limit, with `x = n(1 − c)`,
+/// this is `2x/((2 + x)(1 − e^(−x))) − 1`: `O(x²)` (1 % at `x = 0.35`, 5.5 % at `x = 1`),
+/// tending to +100 % (the lobe's peak is twice the cap's radiance). Evaluated in `f64`.
+pub fn moments_lobe_relative_error(half_angle: f64, n: f64) -> f64 {
+    let s = math::sin64(0.5 * half_angle);
+    let p = 2.0 * s * s;
+    let c = 1.0 - p;
+    // (1 − c^(n+1))/(n + 1) without cancellation: −expm1((n + 1)·ln(1 − p))/(n + 1).
+    let exact = -math::expm1_64((n + 1.0) * math::log1p_64(-p)) / (n + 1.0);
+    let lobe = (1.0 + c) / (2.0 * c / p + n + 1.0);
+    lobe / exact - 1.0
 }
 
 /// A spherical cap: unit axis and half-angle `α ∈ (0, π]`.
@@ -262,10 +297,23 @@ impl SphericalCap {
 
     /// The cosine lobe standing for this cap with radiance `radiance` (eq. 31).
     pub fn lobe(&self, radiance: f32, fit: CapFit) -> CosineLobe {
+        if fit == CapFit::Moments {
+            // `1 − c` held apart (exact for tiny caps), floored where it underflows so the
+            // exponent stays finite (≈ 4e36 at `MIN_HALF_ANGLE`).
+            let p = self
+                .one_minus_cos
+                .max(0.5 * MIN_HALF_ANGLE * MIN_HALF_ANGLE);
+            let c = 1.0 - p;
+            return if c > 0.0 {
+                CosineLobe::saturating(self.axis, radiance * (1.0 + c), 2.0 * c / p)
+            } else {
+                CosineLobe::saturating(self.axis, radiance * p, 0.0)
+            };
+        }
         let e = self.exponent_l2();
         let scale = match fit {
             CapFit::L2 => radiance,
-            CapFit::EnergyPreserving => radiance * self.one_minus_cos * (e + 1.0),
+            CapFit::EnergyPreserving | CapFit::Moments => radiance * self.one_minus_cos * (e + 1.0),
         };
         CosineLobe::saturating(self.axis, scale, e)
     }
@@ -477,6 +525,78 @@ mod tests {
             let l2 = c.lobe(3.0, CapFit::L2);
             assert_eq!(l2.scale(), 3.0);
             assert_eq!(l2.exponent(), l.exponent());
+        }
+    }
+
+    #[test]
+    fn moments_lobe_matches_solid_angle_and_mean_cosine() {
+        // The hemisphere is fitted exactly: the unit indicator of the upper half is `e = 0`.
+        let h = SphericalCap::new(Vec3::Z, FRAC_PI_2)
+            .unwrap()
+            .lobe(2.0, CapFit::Moments);
+        assert!(
+            h.exponent().abs() < 1e-6 && (h.scale() - 2.0).abs() < 1e-6,
+            "{h:?}"
+        );
+        for a in [1e-4f32, 1e-3, 0.01, 0.1, 0.5, 1.0, 1.5, 1.57] {
+            let cap = SphericalCap::new(Vec3::Z, a).unwrap();
+            let l = cap.lobe(1.0, CapFit::Moments);
+            let (p, c) = (f64::from(cap.one_minus_cos()), f64::from(a).cos());
+            let (s, e) = (f64::from(l.scale()), f64::from(l.exponent()));
+            let tau = core::f64::consts::TAU;
+            // ∫ lobe = solid angle, ∫ lobe·(a·ω) = ∫_cap a·ω = π(1 − c²).
+            assert!((tau * s / (e + 1.0) / (tau * p) - 1.0).abs() < 1e-5, "{a}");
+            let mean = core::f64::consts::PI * p * (1.0 + c);
+            assert!((tau * s / (e + 2.0) / mean - 1.0).abs() < 1e-5, "{a}");
+        }
+        // Wider than a hemisphere: the solid angle only; below the smallest half-angle the
+        // exponent stays finite.
+        let w = SphericalCap::new(Vec3::Z, 2.5)
+            .unwrap()
+            .lobe(1.0, CapFit::Moments);
+        assert_eq!(w.exponent(), 0.0);
+        assert!((w.scale() - (1.0 - 2.5f32.cos())).abs() < 1e-6);
+        for a in [1e-18f32, 1e-25, 1e-40] {
+            let t = SphericalCap::new(Vec3::Z, a)
+                .unwrap()
+                .lobe(1.0, CapFit::Moments);
+            assert!(t.exponent().is_finite() && t.scale() == 2.0, "{a}: {t:?}");
+        }
+    }
+
+    /// The product of each fit with a unit lobe of exponent `n` about the cap's axis,
+    /// against the exact `∫_cap (a·ω)^n dω = 2π(1 − c^(n+1))/(n+1)`, over `x = n(1 − c)`:
+    /// the moments lobe is within its stated error, and the better of the two up to
+    /// [`MOMENTS_MAX_X`]; beyond it the energy-preserving lobe is.
+    #[test]
+    fn moments_fit_against_energy_preserving_on_the_axis() {
+        let on_axis =
+            |l: &CosineLobe, n: f64| f64::from(l.scale()) / (f64::from(l.exponent()) + n + 1.0);
+        for a in [1e-3f64, 0.01, 0.1] {
+            let cap = SphericalCap::new(Vec3::Z, a as f32).unwrap();
+            let p = 2.0 * (0.5 * a).sin().powi(2);
+            for (x, moments_bound) in [(0.05, 1e-3), (0.35, 0.011), (1.0, 0.056), (2.0, 0.16)] {
+                let n = x / p;
+                let err = moments_lobe_relative_error(a, n);
+                assert!(err.abs() <= moments_bound, "α {a}, x {x}: {err}");
+                let exact = -math::expm1_64((n + 1.0) * math::log1p_64(-p)) / (n + 1.0);
+                let m = on_axis(&cap.lobe(1.0, CapFit::Moments), n) / exact - 1.0;
+                assert!(
+                    (m - err).abs() < 1e-4 * (1.0 + err.abs()),
+                    "α {a}, x {x}: {m} {err}"
+                );
+            }
+            for x in [0.05, 0.35, 1.0, 2.0, 2.5, 2.9, 3.5, 10.0, 100.0] {
+                let n = x / p;
+                let exact = -math::expm1_64((n + 1.0) * math::log1p_64(-p)) / (n + 1.0);
+                let m = moments_lobe_relative_error(a, n).abs();
+                let ep = (on_axis(&cap.lobe(1.0, CapFit::EnergyPreserving), n) / exact - 1.0).abs();
+                assert_eq!(
+                    m < ep,
+                    x < f64::from(MOMENTS_MAX_X),
+                    "α {a}, x {x}: {m} vs {ep}"
+                );
+            }
         }
     }
 
