@@ -15,11 +15,17 @@
 //! it). Where the radiance changes within a pixel (a glossy highlight, a shadow edge) the
 //! centre alone misses the mean by up to the change; elsewhere nothing is re-shaded.
 //!
-//! The `rsl` method plans `threshold` as [`PLAN_FACTOR`] times its target error (the
-//! render's mean |difference| over the maximum radiance): a pixel is re-shaded where its
-//! centre alone is estimated to miss the pixel's mean by more than that. The harness test
-//! `rsl_method_against_the_path_tracer_on_a_small_environment_scene` asserts the gain
-//! against the path tracer.
+//! **Where to refine.** Re-shading a pixel costs four shading points and removes its
+//! footprint term `e` from the squared error; the path tracer's cost at equal error goes as
+//! `1/E²` (`E` the image's RMS error). So a pixel is worth it where `e² > 4·E²`, i.e. `e`
+//! above about twice the image's RMS error. A method plans `threshold` from its target error
+//! (the render's mean |difference| over the maximum radiance) by the factor its own error at
+//! pixel centres warrants: `rsl` ([`PLAN_FACTOR`]), whose error is close to the target,
+//! twice the target; `lobes` ([`LOBES_PLAN_FACTOR`]), whose error at pixel centres is a
+//! fraction of it, a third. The harness tests
+//! `rsl_method_against_the_path_tracer_on_a_small_environment_scene` and
+//! `lobes_footprint_refinement_against_the_path_tracer` assert the gains against the path
+//! tracer.
 
 use rayon::prelude::*;
 
@@ -30,6 +36,13 @@ use super::{Rgb, Scene, Seen, ShadingPoint};
 /// twice the target re-shades about half the pixels the target itself would on
 /// `environment`, for nearly the same error against the box means.
 pub const PLAN_FACTOR: f64 = 2.0;
+
+/// The `lobes` method's footprint threshold in units of its target error (module docs): its
+/// error at pixel centres is a fraction of the target (mean |difference| from path-traced
+/// pixel centres 1.5e-4 and 5.9e-4 of the maximum on `lobes` and `cluster` at 96 columns,
+/// against the default target 2.8e-3), so the pixels worth re-shading lie far below twice
+/// the target; a third of it (test `lobes_footprint_refinement_against_the_path_tracer`).
+pub const LOBES_PLAN_FACTOR: f64 = 1.0 / 3.0;
 
 /// The 2×2 Gauss–Legendre points of the unit interval, `½ ± 1/(2√3)` (weights ½ each).
 pub const GAUSS_2: [f64; 2] = [0.5 - 0.288_675_134_594_812_9, 0.5 + 0.288_675_134_594_812_9];

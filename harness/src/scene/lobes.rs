@@ -5,8 +5,10 @@
 //!
 //! Per shading point `x` with normal `n`, view `ωo`, and per spherical light:
 //! - the light is the cap it subtends, as one lobe ([`SphericalCap::lobe`], eq. 31–32),
-//!   multiplied by the cosine first ([`Cosine::WithLight`]); energy-preserving by default
-//!   (see [`Options::fit`]);
+//!   multiplied by the cosine first ([`Cosine::WithLight`]): energy-preserving in the
+//!   diffuse chain, the visible fraction the mask's weights were fitted for
+//!   ([`Options::fit`]), and by default the cap's solid angle and mean cosine in the glossy
+//!   chains, whose highlight it keeps sharp ([`Options::glossy_fit`]);
 //! - the reflectance is the material's constant diffuse term `albedo/π` and one unit lobe
 //!   per glossy lobe (modified Phong: about the mirror direction, `(n+2)/(2π)` carried in
 //!   RGB; Lafortune: about `M·ωo`), each chained separately so that every colour channel
@@ -38,7 +40,7 @@
 use glam::{DVec3, Vec3};
 use indicatif::ProgressBar;
 use steradian_core::lobe::CosineLobe;
-use steradian_core::lobe::cap::{CapFit, SphericalCap};
+use steradian_core::lobe::cap::{CapFit, MOMENTS_MAX_X, SphericalCap};
 use steradian_core::lobe::mask::{self, Leaves};
 use steradian_core::lobe::product::{ProductFit, ProductTable, product_with};
 use steradian_core::lobe::sum::{
@@ -46,7 +48,7 @@ use steradian_core::lobe::sum::{
 };
 
 use super::image::Image;
-use super::{Kind, Rgb, Scene, ShadingPoint, Shape, render_centres, render_centres_x8};
+use super::{Kind, Rgb, Scene, ShadingPoint, Shape, footprint, render_centres, render_centres_x8};
 
 /// How visibility becomes lobes.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -72,8 +74,24 @@ pub struct Options {
     /// than the L2 fit of eq. 32 against the path tracer on both `lobes` and `cluster` (the
     /// L2 lobe is wider than the cap and integrates to more than its solid angle).
     pub fit: CapFit,
+    /// How the light's cap becomes its lobe in the glossy chains: [`CapFit::Moments`] by
+    /// default, the cap's solid angle and mean cosine, whose product with a glossy lobe of
+    /// exponent `n` is exact to second order in `x = n(1 − cos α)`; where the receiver's
+    /// sharpest lobe has `x` above [`MOMENTS_MAX_X`], [`Options::fit`] instead (the better
+    /// one there on the axis, core test `moments_fit_against_energy_preserving_on_the_axis`).
+    /// The energy-preserving lobe is wider than the cap (angular variance `α²/0.96`
+    /// against `α²/2`) and blurs a sphere light's highlight: on `lobes` its relative L2
+    /// against path-traced pixel centres is over 5× the moments lobe's (harness test
+    /// `moments_light_lobe_keeps_the_highlights`).
+    pub glossy_fit: CapFit,
     /// Pruning threshold relative to each chain's unshadowed value.
     pub threshold: f32,
+    /// The footprint threshold of [`footprint::refine`], relative to the image's largest
+    /// surface value: pixels whose centre alone is estimated to miss the pixel's mean by
+    /// that much are re-shaded at their 2×2 Gauss–Legendre points, on every path. 0 (the
+    /// default) shades pixel centres only; `steradian render` plans it from the target
+    /// error.
+    pub footprint: f64,
     /// The visibility model.
     pub visibility: Visibility,
     /// The unshadowed diffuse term in closed form ([`SphericalCap::clipped_cosine`], the
@@ -174,7 +192,9 @@ impl Default for Options {
     fn default() -> Self {
         Options {
             fit: CapFit::EnergyPreserving,
+            glossy_fit: CapFit::Moments,
             threshold: 1e-4,
+            footprint: 0.0,
             visibility: Visibility::Mask {
                 depth: mask::MAX_DEPTH,
                 leaves: Leaves::Centre,
@@ -201,7 +221,7 @@ pub fn shade(scene: &Scene, p: &ShadingPoint, o: &Options, counts: &mut ProductC
         // The light's lobe times the cosine is formed by the first chain that uses it.
         let lit = Lit {
             cap: &cap,
-            l: None,
+            l: [None, None],
             occluders: &occ,
             hidden: diffuse_hidden(&cap, &occ, rx.normal, o),
         };
@@ -210,20 +230,20 @@ pub fn shade(scene: &Scene, p: &ShadingPoint, o: &Options, counts: &mut ProductC
     out
 }
 
-/// The light's cap as one lobe (`o.fit`) times the cosine about `normal`, by `kernel` (the
+/// The light's cap as one lobe (`fit`) times the cosine about `normal`, by `kernel` (the
 /// product on `o.table`).
 fn light_lobe<K>(
     kernel: &K,
     cap: &SphericalCap,
     normal: Vec3,
-    o: &Options,
+    fit: CapFit,
     counts: &mut ProductCounts,
 ) -> LobeSum<1>
 where
     K: Fn(&CosineLobe, &CosineLobe) -> CosineLobe,
 {
     let mut l = LobeSum::<1>::new();
-    l.push_cap(cap, 1.0, o.fit);
+    l.push_cap(cap, 1.0, fit);
     light_with_cosine_with(kernel, &l, normal, Cosine::WithLight, counts)
 }
 
@@ -262,52 +282,58 @@ pub fn shade_x8(
         let hidden: [Option<f64>; 8] = core::array::from_fn(|k| {
             caps[k].and_then(|c| diffuse_hidden(&c, &occ[k], rxs[k].normal, o))
         });
-        let needs: [bool; 8] = core::array::from_fn(|k| {
-            caps[k].is_some() && needs_product(&rxs[k], &occ[k], hidden[k], o)
+        // The light's lobe times the cosine each lane's chains will use ([`chain_fits`]).
+        let fits: [[Option<CapFit>; 2]; 8] = core::array::from_fn(|k| match caps[k] {
+            Some(c) => chain_fits(&c, &rxs[k], &occ[k], hidden[k], o),
+            None => [None, None],
         });
         let caps = &caps[..n];
         // `lobe_product` for the batches where some lane uses it: the unit product of the
         // light's unit lobe (a pad where a lane has no light) and the cosine, scaled by the
         // light lobe's scale (the cosine's is 1).
-        let products = needs.contains(&true).then(|| {
-            let pad = CosineLobe::saturating(Vec3::Z, 0.0, 0.0);
-            let lobes: [CosineLobe; 8] = core::array::from_fn(|k| {
-                caps.get(k)
-                    .copied()
-                    .flatten()
-                    .map_or(pad, |c| c.lobe(1.0, o.fit))
-            });
-            let units: [CosineLobe; 8] = core::array::from_fn(|k| {
-                CosineLobe::saturating(lobes[k].axis(), 1.0, lobes[k].exponent())
-            });
-            let cosines: [CosineLobe; 8] = core::array::from_fn(|k| {
-                rxs.get(k)
-                    .map_or(pad, |rx| CosineLobe::saturating(rx.normal, 1.0, 1.0))
-            });
-            let (a, b) = (
-                LobeX8::from_slice(&units[..n]),
-                LobeX8::from_slice(&cosines[..n]),
-            );
-            let q = product_x8(table, ProductFit::ExactIntegral, &a, &b).to_array();
-            core::array::from_fn::<_, 8, _>(|k| {
-                CosineLobe::saturating(
-                    q[k].axis(),
-                    q[k].scale() * lobes[k].scale(),
-                    q[k].exponent(),
-                )
+        let batch = |which: usize| {
+            fits.iter().any(|f| f[which].is_some()).then(|| {
+                let pad = CosineLobe::saturating(Vec3::Z, 0.0, 0.0);
+                let lobes: [CosineLobe; 8] = core::array::from_fn(|k| {
+                    match (caps.get(k).copied().flatten(), fits[k][which]) {
+                        (Some(c), Some(fit)) => c.lobe(1.0, fit),
+                        _ => pad,
+                    }
+                });
+                let units: [CosineLobe; 8] = core::array::from_fn(|k| {
+                    CosineLobe::saturating(lobes[k].axis(), 1.0, lobes[k].exponent())
+                });
+                let cosines: [CosineLobe; 8] = core::array::from_fn(|k| {
+                    rxs.get(k)
+                        .map_or(pad, |rx| CosineLobe::saturating(rx.normal, 1.0, 1.0))
+                });
+                let (a, b) = (
+                    LobeX8::from_slice(&units[..n]),
+                    LobeX8::from_slice(&cosines[..n]),
+                );
+                let q = product_x8(table, ProductFit::ExactIntegral, &a, &b).to_array();
+                core::array::from_fn::<_, 8, _>(|k| {
+                    CosineLobe::saturating(
+                        q[k].axis(),
+                        q[k].scale() * lobes[k].scale(),
+                        q[k].exponent(),
+                    )
+                })
             })
-        });
+        };
+        let products = [batch(0), batch(1)];
         for (k, cap) in caps.iter().enumerate() {
             let Some(cap) = cap else { continue };
-            // Where a chain uses the product (`push_times_cosine`'s count); else the first
-            // chain that does forms it, as in [`shade`].
-            let l = products.filter(|_| needs[k]).map(|lp| {
+            // Each product a chain uses, counted as `push_times_cosine` counts it; a chain
+            // that finds none formed forms its own, as in [`shade`].
+            let l: [Option<LobeSum<1>>; 2] = core::array::from_fn(|w| {
+                let lp = products[w].filter(|_| fits[k][w].is_some())?;
                 counts.computed += 1;
-                LobeSum::<1>::from_lobes(0.0, &[lp[k]])
+                Some(LobeSum::<1>::from_lobes(0.0, &[lp[k]]))
             });
             let lit = Lit {
                 cap,
-                l: l.as_ref(),
+                l: [l[0].as_ref(), l[1].as_ref()],
                 occluders: &occ[k],
                 hidden: hidden[k],
             };
@@ -438,26 +464,50 @@ fn diffuse_hidden(
     )
 }
 
-/// Whether a light at a receiver will use its lobe times the cosine, so that [`shade_x8`]
-/// forms it in the batch: a glossy chain, a shadow chain the diffuse term cannot do without
-/// ([`diffuse_hidden`] is `None` with occluders), or the paper's diffuse chain.
-fn needs_product(
+/// The fit of the light's lobe in the glossy chains at a receiver ([`Options::glossy_fit`]):
+/// [`Options::fit`] where the moments lobe is asked for but the receiver's sharpest lobe has
+/// `n(1 − cos α)` above [`MOMENTS_MAX_X`].
+fn glossy_fit(cap: &SphericalCap, rx: &Receiver, o: &Options) -> CapFit {
+    let n = rx.glossy.iter().map(|g| g.exponent).fold(0.0, f64::max);
+    if o.glossy_fit == CapFit::Moments
+        && n * f64::from(cap.one_minus_cos()) > f64::from(MOMENTS_MAX_X)
+    {
+        o.fit
+    } else {
+        o.glossy_fit
+    }
+}
+
+/// The light's lobes times the cosine a receiver's chains will use, so that [`shade_x8`]
+/// forms them in batches: `[diffuse, glossy]`, the diffuse one ([`Options::fit`]) for a
+/// shadow chain the diffuse term cannot do without ([`diffuse_hidden`] is `None` with
+/// occluders) or the paper's diffuse chain, the glossy one ([`glossy_fit`]) for glossy
+/// chains unless it is the diffuse one's fit, which they then share.
+fn chain_fits(
+    cap: &SphericalCap,
     rx: &Receiver,
     occluders: &[SphericalCap],
     hidden: Option<f64>,
     o: &Options,
-) -> bool {
-    !o.exact_diffuse
-        || (!occluders.is_empty() && hidden.is_none())
-        || rx.glossy.iter().next().is_some()
+) -> [Option<CapFit>; 2] {
+    let diffuse =
+        (!o.exact_diffuse || (!occluders.is_empty() && hidden.is_none())).then_some(o.fit);
+    let glossy = rx
+        .glossy
+        .iter()
+        .next()
+        .map(|_| glossy_fit(cap, rx, o))
+        .filter(|g| diffuse != Some(*g));
+    [diffuse, glossy]
 }
 
-/// One light at one receiver: its cap, its lobe times the cosine when formed ahead (`None`:
-/// the first chain that uses it forms it), the caps of its occluders and what they hide of the
-/// diffuse term when that is exact ([`diffuse_hidden`]).
+/// One light at one receiver: its cap, its lobes times the cosine for the diffuse and the
+/// glossy chains when formed ahead ([`chain_fits`]; `None`: the first chain that uses one
+/// forms it), the caps of its occluders and what they hide of the diffuse term when that is
+/// exact ([`diffuse_hidden`]).
 struct Lit<'a> {
     cap: &'a SphericalCap,
-    l: Option<&'a LobeSum<1>>,
+    l: [Option<&'a LobeSum<1>>; 2],
     occluders: &'a [SphericalCap],
     hidden: Option<f64>,
 }
@@ -522,14 +572,8 @@ fn shade_light(
     let table = o.table.table();
     let kernel =
         |a: &CosineLobe, b: &CosineLobe| product_with(table, ProductFit::ExactIntegral, a, b);
-    // The light's lobe times the cosine where it was not formed ahead, by the first chain.
-    let mut own = None;
-    // A chain's unshadowed and shadowed values.
-    let mut chain = |r: &LobeSum<1>| -> (f64, f64) {
-        let l = match lit.l {
-            Some(l) => l,
-            None => &*own.get_or_insert_with(|| light_lobe(&kernel, lit.cap, rx.normal, o, counts)),
-        };
+    // A chain's unshadowed and shadowed values under the light's lobe times the cosine `l`.
+    let run = |l: &LobeSum<1>, r: &LobeSum<1>, counts: &mut ProductCounts| -> (f64, f64) {
         let u = triple_with(&kernel, r, l, &unoccluded, 0.0, counts);
         if vis.lobes.is_empty() {
             return (u as f64, u as f64);
@@ -537,8 +581,22 @@ fn shade_light(
         let v = triple_with(&kernel, r, l, &vis, o.threshold * u.abs(), counts);
         (u as f64, v as f64)
     };
-    let d = diffuse_needs_chain(lit.hidden, &vis, o).then(|| chain(&diffuse_reflectance()));
-    let glossy = rx.glossy.iter().map(|g| chain(&glossy_reflectance(g)).1);
+    // The lobes times the cosine where not formed ahead, by the first chain that uses each;
+    // the glossy chains share the diffuse chain's where their fits agree.
+    let (fd, fg) = (o.fit, glossy_fit(lit.cap, rx, o));
+    let mut ld = lit.l[0].cloned();
+    let d = diffuse_needs_chain(lit.hidden, &vis, o).then(|| {
+        let l = ld.get_or_insert_with(|| light_lobe(&kernel, lit.cap, rx.normal, fd, counts));
+        let l = *l;
+        run(&l, &diffuse_reflectance(), counts)
+    });
+    let mut lg = lit.l[1].cloned().or(ld.filter(|_| fg == fd));
+    let mut glossy = Vec::with_capacity(rx.glossy.len());
+    for g in rx.glossy.iter() {
+        let l = *lg.get_or_insert_with(|| light_lobe(&kernel, lit.cap, rx.normal, fg, counts));
+        glossy.push(run(&l, &glossy_reflectance(g), counts).1);
+    }
+    let glossy = glossy.into_iter();
     add_light(&scene.lights[li], rx, lit, o, d, glossy, out);
 }
 
@@ -607,7 +665,7 @@ fn prepare(scene: &Scene, p: &ShadingPoint, o: &Options) -> (Receiver, Vec<Light
         let hidden = diffuse_hidden(&cap, &occ, rx.normal, o);
         let lit = Lit {
             cap: &cap,
-            l: None,
+            l: [None, None],
             occluders: &occ,
             hidden,
         };
@@ -658,30 +716,51 @@ fn chain_row(n: Vec3, l: &CosineLobe, r: &LobeSum<1>, vis: (u32, u32), t: f32) -
 /// `steradian_core::wgsl::LOBE_CHAIN` (one row per chain, the light's lobe times the cosine
 /// formed in each), and the chains combined on the CPU as [`shade`] combines them. Each
 /// pixel is within the chains' tolerance of [`render`]'s (harness test
-/// `lobes_gpu_path_matches_the_scalar_path`). The counts are the products computed, the
-/// light's lobe times the cosine counted once per light as [`shade`] counts it; the other
-/// counts stay 0.
+/// `lobes_gpu_path_matches_the_scalar_path`); pixels are then refined at `o.footprint` as
+/// on the CPU paths. The counts are the products computed, the light's lobe times the
+/// cosine counted once per fit its chains use, as [`shade`] counts it; the other counts
+/// stay 0.
 pub fn render_gpu(
     scene: &Scene,
     o: &Options,
     gpu: &mut crate::backend::gpu::Gpu,
     bar: &ProgressBar,
 ) -> Result<(Image, ProductCounts), String> {
-    use crate::backend::gpu::Custom;
-    use crate::kernels::Columns;
-    use rayon::prelude::*;
-
     let (mut img, queue) = super::centre_queue(scene);
     let pixels = img.data.len();
     bar.set_length(pixels as u64);
     bar.inc((pixels - queue.len()) as u64);
-    let product_table = o.table.table().gpu_table();
     let mut counts = ProductCounts::default();
-    for chunk in queue.chunks(GPU_BATCH) {
-        let preps: Vec<(Receiver, Vec<LightPrep>)> = chunk
-            .par_iter()
-            .map(|(_, p)| prepare(scene, p, o))
-            .collect();
+    let points: Vec<ShadingPoint> = queue.iter().map(|(_, p)| *p).collect();
+    let shaded = shade_points_gpu(scene, o, gpu, &points, &mut counts, bar)?;
+    for ((px, _), v) in queue.iter().zip(shaded) {
+        img.data[*px] = v;
+    }
+    footprint::refine(scene, &mut img, o.footprint, |points| {
+        shade_points_gpu(scene, o, gpu, points, &mut counts, &ProgressBar::hidden())
+    })?;
+    Ok((img, counts))
+}
+
+/// The radiance of each point by the wgpu path of [`render_gpu`], [`GPU_BATCH`] points per
+/// dispatch; the products computed are added to `counts`, and `bar` advanced per point.
+fn shade_points_gpu(
+    scene: &Scene,
+    o: &Options,
+    gpu: &mut crate::backend::gpu::Gpu,
+    points: &[ShadingPoint],
+    counts: &mut ProductCounts,
+    bar: &ProgressBar,
+) -> Result<Vec<Rgb>, String> {
+    use crate::backend::gpu::Custom;
+    use crate::kernels::Columns;
+    use rayon::prelude::*;
+
+    let product_table = o.table.table().gpu_table();
+    let mut shaded = Vec::with_capacity(points.len());
+    for chunk in points.chunks(GPU_BATCH) {
+        let preps: Vec<(Receiver, Vec<LightPrep>)> =
+            chunk.par_iter().map(|p| prepare(scene, p, o)).collect();
         let mut table = product_table.clone();
         let mut rows: Vec<[f32; 18]> = Vec::new();
         for (rx, lights) in &preps {
@@ -690,7 +769,11 @@ pub fn render_gpu(
                 if chains == 0 {
                     continue;
                 }
-                counts.computed += 1;
+                // The light's lobe times the cosine, counted once per fit the chains use,
+                // as [`shade`] forms them.
+                let fg = glossy_fit(&lp.cap, rx, o);
+                counts.computed += u64::from(lp.diffuse_chain)
+                    + u64::from(!(rx.glossy.is_empty() || lp.diffuse_chain && fg == o.fit));
                 let off = u32::try_from(table.len())
                     .map_err(|_| "lobes --gpu: table beyond u32 indices".to_string())?;
                 for v in &lp.vis.lobes {
@@ -698,16 +781,16 @@ pub fn render_gpu(
                     table.extend([a.x, a.y, a.z, v.scale(), v.exponent()]);
                 }
                 let vis = (off, lp.vis.lobes.len() as u32);
-                let l = lp.cap.lobe(1.0, o.fit);
                 if lp.diffuse_chain {
                     rows.push(chain_row(
                         rx.normal,
-                        &l,
+                        &lp.cap.lobe(1.0, o.fit),
                         &diffuse_reflectance(),
                         vis,
                         o.threshold,
                     ));
                 }
+                let l = lp.cap.lobe(1.0, fg);
                 for g in rx.glossy.iter() {
                     rows.push(chain_row(
                         rx.normal,
@@ -732,7 +815,7 @@ pub fn render_gpu(
         let n = rows.len();
         let value = |c: usize, r: usize| f64::from(out.data[c * n + r]);
         let mut r = 0;
-        for ((px, _), (rx, lights)) in chunk.iter().zip(&preps) {
+        for (rx, lights) in &preps {
             let mut acc = [0.0; 3];
             for lp in lights {
                 let d = lp.diffuse_chain.then(|| {
@@ -743,7 +826,7 @@ pub fn render_gpu(
                 r += glossy.len();
                 let lit = Lit {
                     cap: &lp.cap,
-                    l: None,
+                    l: [None, None],
                     occluders: &[],
                     hidden: lp.hidden,
                 };
@@ -757,12 +840,12 @@ pub fn render_gpu(
                     &mut acc,
                 );
             }
-            img.data[*px] = acc;
+            shaded.push(acc);
         }
         counts.computed += (0..n).map(|r| value(2, r) as u64).sum::<u64>();
         bar.inc(chunk.len() as u64);
     }
-    Ok((img, counts))
+    Ok(shaded)
 }
 
 /// What [`choose_depth`] chose and what it measured.
@@ -855,24 +938,65 @@ pub fn choose_table(scene: &Scene, o: &Options, target: f64) -> TableChoice {
 /// One pixel-centre sample per pixel ([`super::render_centres`]), surfaces shaded by
 /// [`shade`]; the product counts of the whole image.
 pub fn render(scene: &Scene, o: &Options, bar: &ProgressBar) -> (Image, ProductCounts) {
-    let (img, rows) = render_centres(scene, bar, ProductCounts::default, |counts, p| {
+    let (mut img, rows) = render_centres(scene, bar, ProductCounts::default, |counts, p| {
         shade(scene, p, o, counts)
     });
+    let mut total = sum_counts(rows);
+    refine(scene, &mut img, o, &mut total, |points, counts, out| {
+        for (p, v) in points.iter().zip(out.iter_mut()) {
+            *v = shade(scene, p, o, counts);
+        }
+    });
+    (img, total)
+}
+
+fn sum_counts(rows: impl IntoIterator<Item = ProductCounts>) -> ProductCounts {
     let mut total = ProductCounts::default();
     for c in rows {
         total += c;
     }
-    (img, total)
+    total
+}
+
+/// [`footprint::refine`] at `o.footprint` (nothing where it is 0), the points shaded
+/// `shade(points, counts, out)` up to eight at a time on the thread pool and their product
+/// counts added to `total`. Errors cannot occur: every point given is shaded.
+fn refine(
+    scene: &Scene,
+    img: &mut Image,
+    o: &Options,
+    total: &mut ProductCounts,
+    shade: impl Fn(&[ShadingPoint], &mut ProductCounts, &mut [Rgb]) + Sync,
+) {
+    use rayon::prelude::*;
+    let refined = footprint::refine(scene, img, o.footprint, |points| {
+        let parts: Vec<(Vec<Rgb>, ProductCounts)> = points
+            .par_chunks(8)
+            .map(|ps| {
+                let (mut out, mut c) = (vec![[0.0; 3]; ps.len()], ProductCounts::default());
+                shade(ps, &mut c, &mut out);
+                (out, c)
+            })
+            .collect();
+        let mut all = Vec::with_capacity(points.len());
+        for (v, c) in parts {
+            all.extend(v);
+            *total += c;
+        }
+        Ok(all)
+    });
+    debug_assert!(refined.is_ok(), "every point given is shaded");
 }
 
 /// [`render`] with the points of each row shaded eight at a time by [`shade_x8`].
 pub fn render_simd(scene: &Scene, o: &Options, bar: &ProgressBar) -> (Image, ProductCounts) {
-    let (img, rows) = render_centres_x8(scene, bar, ProductCounts::default, |counts, ps, out| {
-        shade_x8(scene, ps, o, counts, out)
+    let (mut img, rows) =
+        render_centres_x8(scene, bar, ProductCounts::default, |counts, ps, out| {
+            shade_x8(scene, ps, o, counts, out)
+        });
+    let mut total = sum_counts(rows);
+    refine(scene, &mut img, o, &mut total, |points, counts, out| {
+        shade_x8(scene, points, o, counts, out)
     });
-    let mut total = ProductCounts::default();
-    for c in rows {
-        total += c;
-    }
     (img, total)
 }

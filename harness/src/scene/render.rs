@@ -356,9 +356,36 @@ pub fn plan(scene: &Scene, o: &Options) -> Result<Plan, String> {
                 item: "cap_fit".into(),
                 value: json!("energy-preserving"),
                 reason: "cap → lobe with the L2 exponent (eq. 32) scaled to the cap's solid \
-                         angle: closer to the path tracer than the plain L2 lobe (the scene \
-                         tests assert it)"
+                         angle, in the diffuse chain and for occluders: closer to the path \
+                         tracer than the plain L2 lobe (the scene tests assert it), and the \
+                         lobe the mask's weights were fitted for"
                     .into(),
+            });
+            p.push(PlanItem {
+                item: "glossy_cap_fit".into(),
+                value: json!("moments"),
+                reason: format!(
+                    "in the glossy chains the light's lobe has the cap's solid angle and mean \
+                     cosine (closed form): its product with a glossy lobe of exponent n is \
+                     exact to second order in n(1 − cos α), where the energy-preserving \
+                     lobe, wider than the cap, blurs the highlight; the energy-preserving \
+                     lobe where n(1 − cos α) > {}",
+                    steradian_core::lobe::cap::MOMENTS_MAX_X
+                ),
+            });
+            lo.footprint = super::footprint::LOBES_PLAN_FACTOR * o.target_error;
+            p.push(PlanItem {
+                item: "footprint".into(),
+                value: json!(lo.footprint),
+                reason: format!(
+                    "pixels whose centre alone is estimated to miss the pixel's mean (the path \
+                     tracer's box filter) by {} times the target {} of the maximum or more, \
+                     from the image's Laplacian over neighbours on the same object (|Δf|/24), \
+                     are re-shaded at the 2×2 Gauss–Legendre points of the pixel and \
+                     averaged: highlights, shadow edges and the rims of spheres",
+                    super::footprint::LOBES_PLAN_FACTOR,
+                    o.target_error
+                ),
             });
             p.push(PlanItem {
                 item: "diffuse_term".into(),
