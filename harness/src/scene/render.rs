@@ -373,20 +373,25 @@ pub fn plan(scene: &Scene, o: &Options) -> Result<Plan, String> {
                     steradian_core::lobe::cap::MOMENTS_MAX_X
                 ),
             });
-            lo.footprint = super::footprint::LOBES_PLAN_FACTOR * o.target_error;
-            p.push(PlanItem {
-                item: "footprint".into(),
-                value: json!(lo.footprint),
-                reason: format!(
-                    "pixels whose centre alone is estimated to miss the pixel's mean (the path \
-                     tracer's box filter) by {} times the target {} of the maximum or more, \
-                     from the image's Laplacian over neighbours on the same object (|Δf|/24), \
-                     are re-shaded at the 2×2 Gauss–Legendre points of the pixel and \
-                     averaged: highlights, shadow edges and the rims of spheres",
-                    super::footprint::LOBES_PLAN_FACTOR,
-                    o.target_error
-                ),
-            });
+            // `hvl` adds its indirect light at pixel centres: no refinement there (its wgpu
+            // path would refine the direct light alone).
+            if o.method == Method::Lobes {
+                lo.footprint = super::footprint::LOBES_PLAN_FACTOR * o.target_error;
+                p.push(PlanItem {
+                    item: "footprint".into(),
+                    value: json!(lo.footprint),
+                    reason: format!(
+                        "pixels whose centre alone is estimated to miss the pixel's mean (the path \
+                         tracer's box filter) by {:.2} times the target {} of the maximum or \
+                         more (the method's own error at pixel centres is a fraction of the \
+                         target), from the image's Laplacian over neighbours on the same object \
+                         (|Δf|/24), are re-shaded at the 2×2 Gauss–Legendre points of the pixel \
+                         and averaged: highlights, shadow edges and the rims of spheres",
+                        super::footprint::LOBES_PLAN_FACTOR,
+                        o.target_error
+                    ),
+                });
+            }
             p.push(PlanItem {
                 item: "diffuse_term".into(),
                 value: json!("closed form × visible fraction"),
