@@ -15,13 +15,17 @@
 //!   hemisphere), equal to `π sin²α·(n·a)` within its documented `5e-7·π sin²α` (plus the
 //!   `f32` rounding of `n·a`) where the cap is wholly above the horizon and within the bound
 //!   of 0 where wholly below; a non-finite `n` gives NaN;
+//! - every cap → lobe fit (`SphericalCap::lobe`: L2, energy-preserving, moments) gives a
+//!   finite non-negative exponent and scale; the energy-preserving and moments lobes
+//!   integrate to the cap's solid angle within `1e-4` relative (the moments lobe of a cap
+//!   up to a hemisphere; past it, its solid angle);
 //! - `overlap_moment` finite, no longer than the smaller cap's own moment, symmetric in the
 //!   two caps within `1e-5` of that scale, 0 for caps clearly apart and the inner cap's own
 //!   moment `π sin²α·axis` for a cap clearly inside the other; and where `a` is wholly above
 //!   the horizon, `n·overlap ≤ clipped_cosine` (an occluder hides at most the light).
 
 use steradian_core::Vec3;
-use steradian_core::lobe::cap::SphericalCap;
+use steradian_core::lobe::cap::{CapFit, SphericalCap};
 
 const PI: f32 = core::f32::consts::PI;
 
@@ -82,6 +86,25 @@ pub fn check(data: &[u8]) {
     assert_eq!(ca.is_ok(), valid(a_axis, aa), "{a_axis} {aa}: {ca:?}");
     assert_eq!(cb.is_ok(), valid(b_axis, ab), "{b_axis} {ab}: {cb:?}");
     let (Ok(a), Ok(b)) = (ca, cb) else { return };
+
+    // The cap → lobe fits.
+    for fit in [CapFit::L2, CapFit::EnergyPreserving, CapFit::Moments] {
+        let l = a.lobe(1.0, fit);
+        assert!(
+            l.exponent().is_finite() && l.exponent() >= 0.0 && l.scale().is_finite(),
+            "{fit:?} lobe of {a:?}: {l:?}"
+        );
+        assert!(l.scale() >= 0.0, "{fit:?} lobe of {a:?}: {l:?}");
+        // The solid angle, where it is a normal f32 (tiny caps' `1 − cos α` underflows).
+        let omega = a.solid_angle();
+        if fit != CapFit::L2 && omega > 1e-30 {
+            let got = l.integral();
+            assert!(
+                (got / omega - 1.0).abs() <= 1e-4,
+                "{fit:?} lobe of {a:?} integrates to {got}, the cap's solid angle is {omega}"
+            );
+        }
+    }
 
     if !n.is_finite() {
         assert!(a.clipped_cosine(n).is_nan(), "non-finite normal {n}");
