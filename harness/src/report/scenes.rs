@@ -324,6 +324,28 @@ fn lobes_settings<'a>(
         ),
         mk(
             format!(
+                "energy-preserving light lobe in the glossy chains (the paper's fit), t = {:.0e}, depth {depth}",
+                d.threshold
+            ),
+            lobes::Options {
+                glossy_fit: CapFit::EnergyPreserving,
+                ..d
+            },
+            false,
+        ),
+        mk(
+            format!(
+                "pixel centres only (no footprint refinement), t = {:.0e}, depth {depth}",
+                d.threshold
+            ),
+            lobes::Options {
+                footprint: 0.0,
+                ..d
+            },
+            false,
+        ),
+        mk(
+            format!(
                 "lobe product for the unshadowed diffuse term (the paper), t = {:.0e}, depth {depth}",
                 d.threshold
             ),
