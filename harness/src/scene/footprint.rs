@@ -38,10 +38,10 @@ use super::{Rgb, Scene, Seen, ShadingPoint};
 pub const PLAN_FACTOR: f64 = 2.0;
 
 /// The `lobes` method's footprint threshold in units of its target error (module docs): its
-/// error at pixel centres is a fraction of the target (mean |difference| from path-traced
-/// pixel centres 1.5e-4 and 5.9e-4 of the maximum on `lobes` and `cluster` at 96 columns,
-/// against the default target 2.8e-3), so the pixels worth re-shading lie far below twice
-/// the target; a third of it (test `lobes_footprint_refinement_against_the_path_tracer`).
+/// error at pixel centres is a fraction of the target (the report's `scenes` rows for
+/// `lobes` and `cluster` give it beside the pixel centres alone), so the pixels worth
+/// re-shading lie far below twice the target; a third of it (test
+/// `lobes_footprint_refinement_against_the_path_tracer` asserts the gain).
 pub const LOBES_PLAN_FACTOR: f64 = 1.0 / 3.0;
 
 /// The 2×2 Gauss–Legendre points of the unit interval, `½ ± 1/(2√3)` (weights ½ each).

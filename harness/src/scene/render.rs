@@ -148,6 +148,21 @@ fn kernel_name(o: &Options) -> &'static str {
 }
 
 /// A plan's estimates as text: `"{name}{candidate}: {estimate}"`, comma-separated.
+/// The plan item of a method's footprint refinement (`scene::footprint`): `value` is
+/// `factor` times the target error `target`; `what` says where it refines.
+fn footprint_item(value: f64, factor: f64, target: f64, what: &str) -> PlanItem {
+    PlanItem {
+        item: "footprint".into(),
+        value: json!(value),
+        reason: format!(
+            "pixels whose centre alone is estimated to miss the pixel's mean (the path tracer's \
+             box filter) by {factor:.2} times the target {target} of the maximum or more, from \
+             the image's Laplacian over neighbours on the same object (|Δf|/24), are re-shaded \
+             at the 2×2 Gauss–Legendre points of the pixel and averaged: {what}"
+        ),
+    }
+}
+
 fn estimates_text<T: std::fmt::Display>(name: &str, estimates: &[(T, f64)]) -> String {
     estimates
         .iter()
@@ -240,19 +255,12 @@ pub fn plan(scene: &Scene, o: &Options) -> Result<Plan, String> {
                 ),
             });
             r.footprint = super::footprint::PLAN_FACTOR * o.target_error;
-            p.push(PlanItem {
-                item: "footprint".into(),
-                value: json!(r.footprint),
-                reason: format!(
-                    "pixels whose centre alone is estimated to miss the pixel's mean (the path \
-                     tracer's box filter) by {} times the target {} of the maximum or more, from \
-                     the image's Laplacian over neighbours on the same object (|Δf|/24), are \
-                     re-shaded at the 2×2 Gauss–Legendre points of the pixel and averaged: the \
-                     sun's glossy highlight and sharp shadow edges",
-                    super::footprint::PLAN_FACTOR,
-                    o.target_error
-                ),
-            });
+            p.push(footprint_item(
+                r.footprint,
+                super::footprint::PLAN_FACTOR,
+                o.target_error,
+                "the sun's glossy highlight and sharp shadow edges",
+            ));
             p.push(PlanItem {
                 item: "brdf_sats".into(),
                 value: json!(r.sat_target),
@@ -376,21 +384,16 @@ pub fn plan(scene: &Scene, o: &Options) -> Result<Plan, String> {
             // `hvl` adds its indirect light at pixel centres: no refinement there (its wgpu
             // path would refine the direct light alone).
             if o.method == Method::Lobes {
-                lo.footprint = super::footprint::LOBES_PLAN_FACTOR * o.target_error;
-                p.push(PlanItem {
-                    item: "footprint".into(),
-                    value: json!(lo.footprint),
-                    reason: format!(
-                        "pixels whose centre alone is estimated to miss the pixel's mean (the path \
-                         tracer's box filter) by {:.2} times the target {} of the maximum or \
-                         more (the method's own error at pixel centres is a fraction of the \
-                         target), from the image's Laplacian over neighbours on the same object \
-                         (|Δf|/24), are re-shaded at the 2×2 Gauss–Legendre points of the pixel \
-                         and averaged: highlights, shadow edges and the rims of spheres",
-                        super::footprint::LOBES_PLAN_FACTOR,
-                        o.target_error
-                    ),
-                });
+                // Three significant digits: the plan prints it.
+                let t = super::footprint::LOBES_PLAN_FACTOR * o.target_error;
+                lo.footprint = format!("{t:.2e}").parse().unwrap_or(t);
+                p.push(footprint_item(
+                    lo.footprint,
+                    super::footprint::LOBES_PLAN_FACTOR,
+                    o.target_error,
+                    "highlights, shadow edges and the rims of spheres (the method's own \
+                     error at pixel centres is a fraction of the target)",
+                ));
             }
             p.push(PlanItem {
                 item: "diffuse_term".into(),
