@@ -297,25 +297,26 @@ impl SphericalCap {
 
     /// The cosine lobe standing for this cap with radiance `radiance` (eq. 31).
     pub fn lobe(&self, radiance: f32, fit: CapFit) -> CosineLobe {
-        if fit == CapFit::Moments {
-            // `1 − c` held apart (exact for tiny caps), floored where it underflows so the
-            // exponent stays finite (≈ 4e36 at `MIN_HALF_ANGLE`).
-            let p = self
-                .one_minus_cos
-                .max(0.5 * MIN_HALF_ANGLE * MIN_HALF_ANGLE);
-            let c = 1.0 - p;
-            return if c > 0.0 {
-                CosineLobe::saturating(self.axis, radiance * (1.0 + c), 2.0 * c / p)
-            } else {
-                CosineLobe::saturating(self.axis, radiance * p, 0.0)
-            };
+        match fit {
+            CapFit::L2 => CosineLobe::saturating(self.axis, radiance, self.exponent_l2()),
+            CapFit::EnergyPreserving => {
+                let e = self.exponent_l2();
+                CosineLobe::saturating(self.axis, radiance * self.one_minus_cos * (e + 1.0), e)
+            }
+            CapFit::Moments => {
+                // `1 − c` held apart (exact for tiny caps), floored where it underflows so
+                // the exponent stays finite (≈ 4e36 at `MIN_HALF_ANGLE`).
+                let p = self
+                    .one_minus_cos
+                    .max(0.5 * MIN_HALF_ANGLE * MIN_HALF_ANGLE);
+                let c = 1.0 - p;
+                if c > 0.0 {
+                    CosineLobe::saturating(self.axis, radiance * (1.0 + c), 2.0 * c / p)
+                } else {
+                    CosineLobe::saturating(self.axis, radiance * p, 0.0)
+                }
+            }
         }
-        let e = self.exponent_l2();
-        let scale = match fit {
-            CapFit::L2 => radiance,
-            CapFit::EnergyPreserving | CapFit::Moments => radiance * self.one_minus_cos * (e + 1.0),
-        };
-        CosineLobe::saturating(self.axis, scale, e)
     }
 
     /// `∫_cap max(n·ω, 0) dω`: the cosine-weighted solid angle of the cap above the plane
@@ -548,6 +549,11 @@ mod tests {
             assert!((tau * s / (e + 1.0) / (tau * p) - 1.0).abs() < 1e-5, "{a}");
             let mean = core::f64::consts::PI * p * (1.0 + c);
             assert!((tau * s / (e + 2.0) / mean - 1.0).abs() < 1e-5, "{a}");
+            // Small caps: `e ≈ 4/α²`, the cap's angular variance `α²/2` as `2/e`.
+            if a <= 0.01 {
+                let k = e * f64::from(a).powi(2) / 4.0;
+                assert!((k - 1.0).abs() < 1e-4, "{a}: e·α²/4 = {k}");
+            }
         }
         // Wider than a hemisphere: the solid angle only; below the smallest half-angle the
         // exponent stays finite.
@@ -586,6 +592,9 @@ mod tests {
                     "α {a}, x {x}: {m} {err}"
                 );
             }
+            // Very sharp lobes see the moments lobe's peak, twice the cap's radiance.
+            let far = moments_lobe_relative_error(a, 1e4 / p);
+            assert!((0.99..=1.0).contains(&far), "α {a}: {far}");
             for x in [0.05, 0.35, 1.0, 2.0, 2.5, 2.9, 3.5, 10.0, 100.0] {
                 let n = x / p;
                 let exact = -math::expm1_64((n + 1.0) * math::log1p_64(-p)) / (n + 1.0);

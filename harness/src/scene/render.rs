@@ -147,7 +147,6 @@ fn kernel_name(o: &Options) -> &'static str {
     }
 }
 
-/// A plan's estimates as text: `"{name}{candidate}: {estimate}"`, comma-separated.
 /// The plan item of a method's footprint refinement (`scene::footprint`): `value` is
 /// `factor` times the target error `target`; `what` says where it refines.
 fn footprint_item(value: f64, factor: f64, target: f64, what: &str) -> PlanItem {
@@ -163,6 +162,7 @@ fn footprint_item(value: f64, factor: f64, target: f64, what: &str) -> PlanItem 
     }
 }
 
+/// A plan's estimates as text: `"{name}{candidate}: {estimate}"`, comma-separated.
 fn estimates_text<T: std::fmt::Display>(name: &str, estimates: &[(T, f64)]) -> String {
     estimates
         .iter()
