@@ -169,8 +169,9 @@ fn lobe_product_bad_shapes() {
 
 /// `wgsl::LOBE_CHAIN` row by row against its scalar twin (the `lobes` method's chain:
 /// `LobeSum::push_times_cosine_with` on the light's lobe, then `sum::triple_with`
-/// unshadowed and shadowed), with the built-in product table: random normals, cap lobes
-/// of 1e-4 to 1.5 rad, diffuse and glossy reflectances (exponents 0 to 1e5), 0 to 6
+/// unshadowed and shadowed), with the built-in product table, its rows laid out by
+/// `lobes::chain_row` as the method lays them out: random normals, cap lobes of 1e-4 to
+/// 1.5 rad (energy-preserving and moments fits), diffuse and glossy reflectances (exponents 0 to 1e5), 0 to 6
 /// visibility lobes, thresholds 0 and 1e-4, plus the named hard cases (no visibility lobe,
 /// the light straight below the normal, a glossy lobe of exponent 0 and of 1e5). Each
 /// value within `LOBE_CHAIN_REL_TOL` of the chain's scale `|u|·(1 + Σ|w_k|)` plus, with a
@@ -184,6 +185,7 @@ fn lobe_chain_matches_the_scalar_chain_row_by_row() {
     use steradian_core::lobe::cap::{CapFit, SphericalCap};
     use steradian_core::lobe::sum::{LobeSum, LobeTerms, LobeVec, ProductCounts, triple_with};
     use steradian_harness::backend::gpu::Custom;
+    use steradian_harness::scene::lobes;
     let Some(mut g) = gpu() else {
         return;
     };
@@ -201,7 +203,15 @@ fn lobe_chain_matches_the_scalar_chain_row_by_row() {
     for k in 0..2000 {
         let n = rng.dir();
         let cap = SphericalCap::new(rng.dir(), rng.0.log_range(1e-4, 1.5) as f32).unwrap();
-        let light = cap.lobe(1.0, CapFit::EnergyPreserving);
+        // The diffuse chain's lobe and the glossy chains' (the `lobes` method's defaults).
+        let light = cap.lobe(
+            1.0,
+            if k % 4 < 2 {
+                CapFit::EnergyPreserving
+            } else {
+                CapFit::Moments
+            },
+        );
         let r = if k % 2 == 0 {
             diffuse
         } else {
@@ -268,28 +278,7 @@ fn lobe_chain_matches_the_scalar_chain_row_by_row() {
             let a = z.axis();
             data.extend([a.x, a.y, a.z, z.scale(), z.exponent()]);
         }
-        let (la, rl) = (light.axis(), r.lobes().first());
-        let (ra, rs, re) = rl.map_or((Vec3::Z, 0.0, 0.0), |q| (q.axis(), q.scale(), q.exponent()));
-        rows.push([
-            n.x,
-            n.y,
-            n.z,
-            la.x,
-            la.y,
-            la.z,
-            light.scale(),
-            light.exponent(),
-            r.constant(),
-            r.lobes().len() as f32,
-            ra.x,
-            ra.y,
-            ra.z,
-            rs,
-            re,
-            f32::from_bits(off),
-            f32::from_bits(vis.len() as u32),
-            *t,
-        ]);
+        rows.push(lobes::chain_row(*n, light, r, (off, vis.len() as u32), *t));
     }
     let input = Columns::from_rows(&rows);
     let mut out = Columns::zeros(3, rows.len());

@@ -490,8 +490,13 @@ fn chain_fits(
     hidden: Option<f64>,
     o: &Options,
 ) -> [Option<CapFit>; 2] {
-    let diffuse =
-        (!o.exact_diffuse || (!occluders.is_empty() && hidden.is_none())).then_some(o.fit);
+    let diffuse = !o.exact_diffuse || (!occluders.is_empty() && hidden.is_none());
+    fits_with(diffuse, cap, rx, o)
+}
+
+/// [`chain_fits`] where whether the diffuse chain runs is known (`diffuse`).
+fn fits_with(diffuse: bool, cap: &SphericalCap, rx: &Receiver, o: &Options) -> [Option<CapFit>; 2] {
+    let diffuse = diffuse.then_some(o.fit);
     let glossy = rx
         .glossy
         .iter()
@@ -682,10 +687,11 @@ fn prepare(scene: &Scene, p: &ShadingPoint, o: &Options) -> (Receiver, Vec<Light
     (rx, lights)
 }
 
-/// The input row of `steradian_core::wgsl::LOBE_CHAIN` for reflectance `r` at normal `n`
-/// under the light lobe `l`, its visibility lobes at `vis` (offset and count in the
-/// table).
-fn chain_row(n: Vec3, l: &CosineLobe, r: &LobeSum<1>, vis: (u32, u32), t: f32) -> [f32; 18] {
+/// The input row of `steradian_core::wgsl::LOBE_CHAIN` for reflectance `r` (a constant and
+/// at most one lobe) at normal `n` under the light lobe `l`, its visibility lobes at `vis`
+/// (offset and count, in lobes of five floats, in the table after the product table),
+/// pruning threshold `t`.
+pub fn chain_row(n: Vec3, l: &CosineLobe, r: &LobeSum<1>, vis: (u32, u32), t: f32) -> [f32; 18] {
     let (la, rl) = (l.axis(), r.lobes().first());
     let (ra, rs, re) = rl.map_or((Vec3::Z, 0.0, 0.0), |g| (g.axis(), g.scale(), g.exponent()));
     [
@@ -771,9 +777,8 @@ fn shade_points_gpu(
                 }
                 // The light's lobe times the cosine, counted once per fit the chains use,
                 // as [`shade`] forms them.
-                let fg = glossy_fit(&lp.cap, rx, o);
-                counts.computed += u64::from(lp.diffuse_chain)
-                    + u64::from(!(rx.glossy.is_empty() || lp.diffuse_chain && fg == o.fit));
+                let fits = fits_with(lp.diffuse_chain, &lp.cap, rx, o);
+                counts.computed += fits.iter().flatten().count() as u64;
                 let off = u32::try_from(table.len())
                     .map_err(|_| "lobes --gpu: table beyond u32 indices".to_string())?;
                 for v in &lp.vis.lobes {
@@ -790,7 +795,7 @@ fn shade_points_gpu(
                         o.threshold,
                     ));
                 }
-                let l = lp.cap.lobe(1.0, fg);
+                let l = lp.cap.lobe(1.0, glossy_fit(&lp.cap, rx, o));
                 for g in rx.glossy.iter() {
                     rows.push(chain_row(
                         rx.normal,
