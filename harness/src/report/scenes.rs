@@ -501,14 +501,10 @@ fn rsl_settings<'a>(
     scene: &'a Scene,
     gpu: Option<&'a std::sync::Mutex<crate::backend::gpu::Gpu>>,
 ) -> (Vec<Setting<'a>>, Vec<Setting<'a>>) {
-    // What `steradian render` plans (cube face, visibility side, coverage depth) with K set
-    // to the paper's 30 and swept over `RSL_KS`; the plan's own K is in its JSON.
+    // What `steradian render` plans (K, cube face, visibility side, coverage depth), K
+    // swept over `RSL_KS` and the plan's own; the paper's pipeline at the paper's K = 30.
     let paper_k = rsl::Options::default().k;
-    let d =
-        planned(scene, render::Method::Rsl).map_or_else(rsl::Options::default, |p| rsl::Options {
-            k: paper_k,
-            ..p.rsl
-        });
+    let d = planned(scene, render::Method::Rsl).map_or_else(rsl::Options::default, |p| p.rsl);
     // `ratio`: the shadow ratio (the default), or the paper's pipeline without it;
     // `refined`: the planned footprint refinement, or pixel centres only.
     let setting = |k: usize, kernel: RslKernel, ratio: bool, refined: bool| {
@@ -560,12 +556,17 @@ fn rsl_settings<'a>(
         }
     };
     let (ratio, refined) = (d.exact_unshadowed, d.footprint > 0.0);
-    let curve = RSL_KS
+    let mut ks = RSL_KS.to_vec();
+    if !ks.contains(&d.k) {
+        ks.push(d.k);
+        ks.sort_unstable();
+    }
+    let curve = ks
         .iter()
         .map(|&k| setting(k, RslKernel::Simd, ratio, refined))
         .collect();
     let mut variants = vec![
-        setting(d.k, RslKernel::Simd, false, false),
+        setting(paper_k, RslKernel::Simd, false, false),
         setting(d.k, RslKernel::Simd, true, false),
         setting(d.k, RslKernel::Scalar, ratio, refined),
     ];
