@@ -48,23 +48,15 @@ pub const LOBES_PLAN_FACTOR: f64 = 1.0 / 3.0;
 /// The 2×2 Gauss–Legendre points of the unit interval, `½ ± 1/(2√3)` (weights ½ each).
 pub const GAUSS_2: [f64; 2] = [0.5 - 0.288_675_134_594_812_9, 0.5 + 0.288_675_134_594_812_9];
 
-/// The estimated footprint term `max_c |Δf_c|/24` of every pixel whose centre sees a
-/// surface with a neighbour on the same object (module docs), `None` for the others.
-pub fn footprint_estimates(scene: &Scene, img: &Image) -> Vec<Option<f64>> {
-    let cam = scene.camera;
-    let (w, h) = (cam.width as usize, cam.height as usize);
-    let objects: Vec<Option<usize>> = (0..w * h)
-        .into_par_iter()
-        .map(
-            |k| match scene.see(&cam.centre_ray((k % w) as u32, (k / w) as u32)) {
-                Seen::Surface(p) => Some(p.object),
-                Seen::Radiance(_) => None,
-            },
-        )
-        .collect();
+/// The estimated footprint term `max_c |Δf_c|/24` of every pixel of `img` whose centre
+/// sees a surface (`objects`, row-major, the centre pass's) with a neighbour on the same
+/// object (module docs), `None` for the others.
+pub fn footprint_estimates(img: &Image, objects: &[Option<usize>]) -> Vec<Option<f64>> {
+    let (w, h) = (img.width, img.height);
+    let object = |k: usize| objects.get(k).copied().flatten();
     (0..w * h)
         .map(|k| {
-            let own = objects[k]?;
+            let own = object(k)?;
             let (i, j) = (k % w, k / w);
             let near = [
                 (i > 0).then(|| k - 1),
@@ -74,7 +66,7 @@ pub fn footprint_estimates(scene: &Scene, img: &Image) -> Vec<Option<f64>> {
             ];
             let (mut sum, mut count) = ([0.0f64; 3], 0usize);
             for n in near.into_iter().flatten() {
-                if objects[n] == Some(own) {
+                if object(n) == Some(own) {
                     count += 1;
                     for (c, v) in sum.iter_mut().enumerate() {
                         *v += img.data[n][c] - img.data[k][c];
@@ -90,8 +82,9 @@ pub fn footprint_estimates(scene: &Scene, img: &Image) -> Vec<Option<f64>> {
         .collect()
 }
 
-/// Re-shades the pixels of `img` whose estimated footprint term reaches `threshold` times
-/// the image's largest surface value (module docs) at their 2×2 Gauss–Legendre points,
+/// Re-shades the pixels of `img` (its centre pass's [`super::Objects`] in `objects`) whose
+/// estimated footprint term reaches `threshold` times the image's largest surface value
+/// (module docs) at their 2×2 Gauss–Legendre points,
 /// through `shade` (any number of surface points in, one radiance each out, in order);
 /// a point that sees no surface takes the radiance it sees. Returns the number of pixels
 /// re-shaded. Nothing is re-shaded for a `threshold` that is not positive.
@@ -100,13 +93,14 @@ pub fn footprint_estimates(scene: &Scene, img: &Image) -> Vec<Option<f64>> {
 pub fn refine(
     scene: &Scene,
     img: &mut Image,
+    objects: &[Option<usize>],
     threshold: f64,
     shade: impl FnOnce(&[ShadingPoint]) -> Result<Vec<Rgb>, String>,
 ) -> Result<usize, String> {
     if threshold.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater) {
         return Ok(0);
     }
-    let est = footprint_estimates(scene, img);
+    let est = footprint_estimates(img, objects);
     let max = img
         .data
         .iter()
@@ -185,10 +179,11 @@ mod tests {
             img.data.iter_mut().for_each(|p| *p = [v; 3]);
             img
         };
+        let objects = crate::scene::centre_objects(&scene);
         let never = |_: &[ShadingPoint]| -> Result<Vec<Rgb>, String> {
             panic!("nothing should be re-shaded")
         };
-        assert_eq!(refine(&scene, &mut flat(1.0), 1e-3, never), Ok(0));
+        assert_eq!(refine(&scene, &mut flat(1.0), &objects, 1e-3, never), Ok(0));
         // A step between columns 11 and 12.
         let mut step = flat(1.0);
         for (k, p) in step.data.iter_mut().enumerate() {
@@ -196,9 +191,15 @@ mod tests {
                 *p = [2.0; 3];
             }
         }
-        assert_eq!(refine(&scene, &mut step.clone(), 0.0, never), Ok(0));
-        assert_eq!(refine(&scene, &mut step.clone(), -1.0, never), Ok(0));
-        let est = footprint_estimates(&scene, &step);
+        assert_eq!(
+            refine(&scene, &mut step.clone(), &objects, 0.0, never),
+            Ok(0)
+        );
+        assert_eq!(
+            refine(&scene, &mut step.clone(), &objects, -1.0, never),
+            Ok(0)
+        );
+        let est = footprint_estimates(&step, &objects);
         let want: Vec<usize> = (0..w * h)
             .filter(|&k| est[k].is_some_and(|e| e >= 0.01 * 2.0))
             .collect();
@@ -206,7 +207,7 @@ mod tests {
         assert!(want.iter().all(|&k| k % w == 11 || k % w == 12), "{want:?}");
         let mut refined = step.clone();
         let mut given = 0;
-        let n = refine(&scene, &mut refined, 0.01, |pts| {
+        let n = refine(&scene, &mut refined, &objects, 0.01, |pts| {
             given = pts.len();
             Ok(vec![[8.0; 3]; pts.len()])
         })
@@ -221,7 +222,13 @@ mod tests {
                 assert_eq!(refined.data[k], step.data[k], "pixel {k}");
             }
         }
-        let short = refine(&scene, &mut step.clone(), 0.01, |_| Ok(Vec::new()));
+        let short = refine(
+            &scene,
+            &mut step.clone(),
+            &objects,
+            0.01,
+            |_| Ok(Vec::new()),
+        );
         assert!(short.is_err());
     }
 

@@ -691,7 +691,7 @@ pub fn render_gpu(
     // CPU beside it.
     let (direct, _) = lobes::render_gpu(scene, &o.direct, gpu, &ProgressBar::hidden())?;
     let width = scene.camera.width as usize;
-    let (mut img, _) = super::render_centres_x8_at(
+    let (mut img, _, _) = super::render_centres_x8_at(
         scene,
         bar,
         Scratch::default,
@@ -897,7 +897,7 @@ pub fn render(scene: &Scene, o: &Options, bar: &ProgressBar) -> (Image, usize) {
         })
     });
     let new_state = || (ProductCounts::default(), Scratch::default());
-    let (img, _) =
+    let (img, _, _) =
         super::render_centres_x8_at(scene, bar, new_state, |(counts, scratch), pix, ps, out| {
             if o.simd {
                 // The direct light by the `lobes` method's SIMD path, eight points at a time.

@@ -742,7 +742,8 @@ pub fn render_gpu(
     for ((px, _), v) in queue.iter().zip(shaded) {
         img.data[*px] = v;
     }
-    footprint::refine(scene, &mut img, o.footprint, |points| {
+    let objects = super::queue_objects(pixels, &queue);
+    footprint::refine(scene, &mut img, &objects, o.footprint, |points| {
         shade_points_gpu(scene, o, gpu, points, &mut counts, &ProgressBar::hidden())
     })?;
     Ok((img, counts))
@@ -943,15 +944,23 @@ pub fn choose_table(scene: &Scene, o: &Options, target: f64) -> TableChoice {
 /// One pixel-centre sample per pixel ([`super::render_centres`]), surfaces shaded by
 /// [`shade`]; the product counts of the whole image.
 pub fn render(scene: &Scene, o: &Options, bar: &ProgressBar) -> (Image, ProductCounts) {
-    let (mut img, rows) = render_centres(scene, bar, ProductCounts::default, |counts, p| {
-        shade(scene, p, o, counts)
-    });
+    let (mut img, rows, objects) =
+        render_centres(scene, bar, ProductCounts::default, |counts, p| {
+            shade(scene, p, o, counts)
+        });
     let mut total = sum_counts(rows);
-    refine(scene, &mut img, o, &mut total, |points, counts, out| {
-        for (p, v) in points.iter().zip(out.iter_mut()) {
-            *v = shade(scene, p, o, counts);
-        }
-    });
+    refine(
+        scene,
+        &mut img,
+        &objects,
+        o,
+        &mut total,
+        |points, counts, out| {
+            for (p, v) in points.iter().zip(out.iter_mut()) {
+                *v = shade(scene, p, o, counts);
+            }
+        },
+    );
     (img, total)
 }
 
@@ -969,12 +978,13 @@ fn sum_counts(rows: impl IntoIterator<Item = ProductCounts>) -> ProductCounts {
 fn refine(
     scene: &Scene,
     img: &mut Image,
+    objects: &[Option<usize>],
     o: &Options,
     total: &mut ProductCounts,
     shade: impl Fn(&[ShadingPoint], &mut ProductCounts, &mut [Rgb]) + Sync,
 ) {
     use rayon::prelude::*;
-    let refined = footprint::refine(scene, img, o.footprint, |points| {
+    let refined = footprint::refine(scene, img, objects, o.footprint, |points| {
         let parts: Vec<(Vec<Rgb>, ProductCounts)> = points
             .par_chunks(8)
             .map(|ps| {
@@ -995,13 +1005,18 @@ fn refine(
 
 /// [`render`] with the points of each row shaded eight at a time by [`shade_x8`].
 pub fn render_simd(scene: &Scene, o: &Options, bar: &ProgressBar) -> (Image, ProductCounts) {
-    let (mut img, rows) =
+    let (mut img, rows, objects) =
         render_centres_x8(scene, bar, ProductCounts::default, |counts, ps, out| {
             shade_x8(scene, ps, o, counts, out)
         });
     let mut total = sum_counts(rows);
-    refine(scene, &mut img, o, &mut total, |points, counts, out| {
-        shade_x8(scene, points, o, counts, out)
-    });
+    refine(
+        scene,
+        &mut img,
+        &objects,
+        o,
+        &mut total,
+        |points, counts, out| shade_x8(scene, points, o, counts, out),
+    );
     (img, total)
 }

@@ -316,15 +316,45 @@ pub enum Seen {
     Surface(ShadingPoint),
 }
 
+/// The object each pixel's centre ray meets first (row-major), `None` where it sees a light
+/// or the environment: kept from the centre pass for the footprint refinement, which
+/// compares neighbours by it ([`footprint::refine`]), rather than cast again.
+pub type Objects = Vec<Option<usize>>;
+
+/// [`Objects`] of the pixels of a [`centre_queue`]: `pixels` of them in all, those in
+/// `queue` on their surface's object.
+pub fn queue_objects(pixels: usize, queue: &[(usize, ShadingPoint)]) -> Objects {
+    let mut objects = vec![None; pixels];
+    for (k, p) in queue {
+        objects[*k] = Some(p.object);
+    }
+    objects
+}
+
+/// [`Objects`] cast afresh, for an image that comes without them.
+pub fn centre_objects(scene: &Scene) -> Objects {
+    let cam = scene.camera;
+    let (w, h) = (cam.width as usize, cam.height as usize);
+    (0..w * h)
+        .into_par_iter()
+        .map(
+            |k| match scene.see(&cam.centre_ray((k % w) as u32, (k / w) as u32)) {
+                Seen::Surface(p) => Some(p.object),
+                Seen::Radiance(_) => None,
+            },
+        )
+        .collect()
+}
+
 /// The image of the pixel-centre rays, rows in parallel: a light or the environment as
 /// seen, a surface by `shade(state, point)`. Each row gets a fresh `new_state()` (scratch
-/// buffers, counters), returned row by row with the image.
+/// buffers, counters), returned row by row with the image and its [`Objects`].
 pub fn render_centres<S: Send>(
     scene: &Scene,
     bar: &ProgressBar,
     new_state: impl Fn() -> S + Sync,
     shade: impl Fn(&mut S, &ShadingPoint) -> Rgb + Sync,
-) -> (Image, Vec<S>) {
+) -> (Image, Vec<S>, Objects) {
     // The same walk as the batched one, each point alone (in the same order per row).
     render_centres_x8(scene, bar, new_state, |state, points, out| {
         for (p, o) in points.iter().zip(out.iter_mut()) {
@@ -360,7 +390,7 @@ pub fn render_centres_x8<S: Send>(
     bar: &ProgressBar,
     new_state: impl Fn() -> S + Sync,
     shade: impl Fn(&mut S, &[ShadingPoint], &mut [Rgb]) + Sync,
-) -> (Image, Vec<S>) {
+) -> (Image, Vec<S>, Objects) {
     render_centres_x8_at(scene, bar, new_state, |state, _, ps, out| {
         shade(state, ps, out)
     })
@@ -374,20 +404,22 @@ pub fn render_centres_x8_at<S: Send>(
     bar: &ProgressBar,
     new_state: impl Fn() -> S + Sync,
     shade: impl Fn(&mut S, &[(usize, usize)], &[ShadingPoint], &mut [Rgb]) + Sync,
-) -> (Image, Vec<S>) {
+) -> (Image, Vec<S>, Objects) {
     let cam = scene.camera;
     let (w, h) = (cam.width as usize, cam.height as usize);
-    let rows: Vec<(Vec<Rgb>, S)> = (0..h)
+    let rows: Vec<(Vec<Rgb>, S, Objects)> = (0..h)
         .into_par_iter()
         .map(|j| {
             let mut state = new_state();
             let mut row = vec![[0.0; 3]; w];
+            let mut objects = vec![None; w];
             let mut pixels = Vec::with_capacity(w);
             let mut points = Vec::with_capacity(w);
-            for (i, px) in row.iter_mut().enumerate() {
+            for (i, (px, object)) in row.iter_mut().zip(&mut objects).enumerate() {
                 match scene.see(&cam.centre_ray(i as u32, j as u32)) {
                     Seen::Radiance(l) => *px = l,
                     Seen::Surface(p) => {
+                        *object = Some(p.object);
                         pixels.push((i, j));
                         points.push(p);
                     }
@@ -402,16 +434,18 @@ pub fn render_centres_x8_at<S: Send>(
                 }
             }
             bar.inc(1);
-            (row, state)
+            (row, state, objects)
         })
         .collect();
     let mut img = Image::new(w, h);
     let mut states = Vec::with_capacity(h);
-    for (j, (row, state)) in rows.into_iter().enumerate() {
+    let mut objects = Vec::with_capacity(w * h);
+    for (j, (row, state, row_objects)) in rows.into_iter().enumerate() {
         img.data[j * w..(j + 1) * w].copy_from_slice(&row);
         states.push(state);
+        objects.extend(row_objects);
     }
-    (img, states)
+    (img, states, objects)
 }
 
 /// The share of `--target-error` each planned setting may add to a render ([`rsl::choose_k`],

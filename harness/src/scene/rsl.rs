@@ -1003,15 +1003,17 @@ pub fn render_built_simd(
         }
         Ok(radiance)
     };
-    let rows: Vec<Result<Vec<Rgb>, String>> = (0..h)
+    let rows: Vec<Result<(Vec<Rgb>, super::Objects), String>> = (0..h)
         .into_par_iter()
         .map(|j| {
             let mut row = vec![[0.0; 3]; w];
+            let mut objects = vec![None; w];
             let (mut at, mut surface) = (Vec::with_capacity(w), Vec::with_capacity(w));
-            for (i, px) in row.iter_mut().enumerate() {
+            for (i, (px, object)) in row.iter_mut().zip(&mut objects).enumerate() {
                 match scene.see(&cam.centre_ray(i as u32, j as u32)) {
                     Seen::Radiance(l) => *px = l,
                     Seen::Surface(p) => {
+                        *object = Some(p.object);
                         at.push(i);
                         surface.push(p);
                     }
@@ -1021,14 +1023,17 @@ pub fn render_built_simd(
                 row[i] = v;
             }
             bar.inc(1);
-            Ok(row)
+            Ok((row, objects))
         })
         .collect();
     let mut img = Image::new(w, h);
+    let mut objects = Vec::with_capacity(w * h);
     for (j, row) in rows.into_iter().enumerate() {
-        img.data[j * w..(j + 1) * w].copy_from_slice(&row?);
+        let (row, row_objects) = row?;
+        img.data[j * w..(j + 1) * w].copy_from_slice(&row);
+        objects.extend(row_objects);
     }
-    footprint::refine(scene, &mut img, o.footprint, |points| {
+    footprint::refine(scene, &mut img, &objects, o.footprint, |points| {
         let parts = points
             .par_chunks(w.max(8))
             .map(shade_points)
@@ -1055,10 +1060,10 @@ pub fn render_built(
 ) -> Result<Image, String> {
     use rayon::prelude::*;
     let new_cov = || vec![0.0f32; o.vis_side * o.vis_side];
-    let (mut img, _) = render_centres(scene, bar, new_cov, |cov, p| {
+    let (mut img, _, objects) = render_centres(scene, bar, new_cov, |cov, p| {
         shade_point(scene, built, o, p, cov)
     });
-    footprint::refine(scene, &mut img, o.footprint, |points| {
+    footprint::refine(scene, &mut img, &objects, o.footprint, |points| {
         Ok(points
             .par_iter()
             .map_init(new_cov, |cov, p| shade_point(scene, built, o, p, cov))
@@ -1092,7 +1097,8 @@ pub fn render_built_gpu(
         img.data[*k] = v;
     }
     bar.set_position(img.data.len() as u64);
-    footprint::refine(scene, &mut img, o.footprint, |points| {
+    let objects = super::queue_objects(img.data.len(), &queue);
+    footprint::refine(scene, &mut img, &objects, o.footprint, |points| {
         shade_points_gpu(scene, built, o, gpu, points, &ProgressBar::hidden())
     })?;
     Ok(img)
