@@ -15,6 +15,14 @@
 //! it). Where the radiance changes within a pixel (a glossy highlight, a shadow edge) the
 //! centre alone misses the mean by up to the change; elsewhere nothing is re-shaded.
 //!
+//! **Small objects.** An object seen by fewer than [`SMALL_OBJECT_PIXELS`] pixel centres
+//! has all its pixels re-shaded: across a pixel of a sphere of radius 2 pixels the normal
+//! turns by about 30°, and its shading can change between centres that all agree. On
+//! `cluster` a small sphere in the umbra at each of its pixel centres is lit on a crescent
+//! between them: the centres say 0 and the path tracer's box mean does not, and near black
+//! the tone mapping magnifies the difference (the rule: test
+//! `refine_reshades_small_objects_whole`; its gain: the report's `cluster` rows).
+//!
 //! **Where to refine.** Re-shading a pixel costs four shading points and removes its
 //! footprint term `e` from the squared error; the path tracer's cost at equal error goes as
 //! `1/E²` (`E` the image's RMS error). So a pixel is worth it where `e² > 4·E²`, i.e. `e`
@@ -38,12 +46,18 @@ use super::{Rgb, Scene, Seen, ShadingPoint};
 /// asserts the gain).
 pub const PLAN_FACTOR: f64 = 2.0;
 
-/// The `lobes` method's footprint threshold in units of its target error (module docs): its
+/// The `lobes` method's footprint threshold in units of its target error (module docs; the
+/// `hvl` method refines its direct light, the `lobes` method's, by it too): its
 /// error at pixel centres is a fraction of the target (the report's `scenes` rows for
 /// `lobes` and `cluster` give it beside the pixel centres alone), so the pixels worth
 /// re-shading lie far below twice the target; a third of it (test
 /// `lobes_footprint_refinement_against_the_path_tracer` asserts the gain).
 pub const LOBES_PLAN_FACTOR: f64 = 1.0 / 3.0;
+
+/// Objects whose surface fewer pixel centres see than this have every pixel re-shaded
+/// where refinement is on, whatever its estimate (module docs): about a disc of radius 2
+/// pixels, too few for neighbours on the object to resolve its shading.
+pub const SMALL_OBJECT_PIXELS: usize = 16;
 
 /// The 2×2 Gauss–Legendre points of the unit interval, `½ ± 1/(2√3)` (weights ½ each).
 pub const GAUSS_2: [f64; 2] = [0.5 - 0.288_675_134_594_812_9, 0.5 + 0.288_675_134_594_812_9];
@@ -108,8 +122,20 @@ pub fn refine(
         .filter(|(_, e)| e.is_some())
         .flat_map(|(v, _)| v.iter().copied())
         .fold(0.0, f64::max);
+    // Pixels per object: the small objects' pixels are re-shaded whatever their estimate.
+    let mut size = std::collections::HashMap::<usize, usize>::new();
+    for o in objects.iter().flatten() {
+        *size.entry(*o).or_insert(0) += 1;
+    }
+    let small = |k: usize| {
+        objects
+            .get(k)
+            .copied()
+            .flatten()
+            .is_some_and(|o| size.get(&o).is_some_and(|&n| n < SMALL_OBJECT_PIXELS))
+    };
     let chosen: Vec<usize> = (0..est.len())
-        .filter(|&k| est[k].is_some_and(|e| e > 0.0 && e >= threshold * max))
+        .filter(|&k| est[k].is_some_and(|e| e > 0.0 && e >= threshold * max) || small(k))
         .collect();
     if chosen.is_empty() {
         return Ok(0);
@@ -168,7 +194,7 @@ mod tests {
     /// step across the image re-shades exactly the surface pixels beside it whose
     /// estimate reaches the threshold, four points each (fewer where a point sees no
     /// surface), and each takes the mean of its four; a closure that answers another
-    /// count is an error.
+    /// count is an error. (Every surface is one object here: none is small.)
     #[test]
     fn refine_reshades_only_where_the_estimate_reaches_the_threshold() {
         let mut scene = Scene::load("builtin:lobes").unwrap();
@@ -179,7 +205,11 @@ mod tests {
             img.data.iter_mut().for_each(|p| *p = [v; 3]);
             img
         };
-        let objects = crate::scene::centre_objects(&scene);
+        // Every surface one object, so that none is small.
+        let objects: Vec<Option<usize>> = crate::scene::centre_objects(&scene)
+            .into_iter()
+            .map(|o| o.map(|_| 0))
+            .collect();
         let never = |_: &[ShadingPoint]| -> Result<Vec<Rgb>, String> {
             panic!("nothing should be re-shaded")
         };
@@ -230,6 +260,46 @@ mod tests {
             |_| Ok(Vec::new()),
         );
         assert!(short.is_err());
+    }
+
+    /// An object seen by fewer than [`SMALL_OBJECT_PIXELS`] pixel centres is re-shaded at
+    /// every pixel even where the image is flat (its estimate 0); the large objects of the
+    /// same flat image are not.
+    #[test]
+    fn refine_reshades_small_objects_whole() {
+        let mut scene = Scene::load("builtin:lobes").unwrap();
+        scene.camera = scene.camera.resized(24).unwrap();
+        let (w, h) = (scene.camera.width as usize, scene.camera.height as usize);
+        // Every surface one large object but for a 3 × 2 block, a small object of its own.
+        let mut objects: Vec<Option<usize>> = crate::scene::centre_objects(&scene)
+            .into_iter()
+            .map(|o| o.map(|_| 0))
+            .collect();
+        let small = usize::MAX;
+        let block: Vec<usize> = (10..12)
+            .flat_map(|j| (8..11).map(move |i| j * w + i))
+            .collect();
+        assert!(block.iter().all(|&k| objects[k].is_some()));
+        for &k in &block {
+            objects[k] = Some(small);
+        }
+        let mut img = Image::new(w, h);
+        img.data.iter_mut().for_each(|p| *p = [1.0; 3]);
+        let mut given = 0;
+        let n = refine(&scene, &mut img, &objects, 1e-3, |pts| {
+            given = pts.len();
+            Ok(vec![[3.0; 3]; pts.len()])
+        })
+        .unwrap();
+        assert_eq!(n, block.len());
+        assert!(given <= 4 * n && given > 0, "{given} points for {n} pixels");
+        for k in 0..w * h {
+            if block.contains(&k) {
+                assert_ne!(img.data[k], [1.0; 3], "pixel {k}");
+            } else {
+                assert_eq!(img.data[k], [1.0; 3], "pixel {k}");
+            }
+        }
     }
 
     /// The 2×2 Gauss–Legendre mean is the unit box's mean of every monomial `x^a·y^b` with
