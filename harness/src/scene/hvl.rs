@@ -881,12 +881,13 @@ pub fn choose_stride(scene: &Scene, o: &Options, target: f64) -> StrideChoice {
     StrideChoice { stride, estimates }
 }
 
-/// Direct light by the `lobes` method plus one bounce from HVLs, one pixel-centre sample
-/// per pixel ([`super::render_centres_x8_at`]), the indirect light interpolated on a
-/// [`lattice::Lattice`] of spacing `o.stride` when it is above 1 (indirect light from
-/// hundreds of HVLs varies slowly across a surface: each HVL's share is smooth in the
-/// receiver's position and normal, and the glossy parts are band-limited by their SH
-/// tables); returns the image and the HVL count.
+/// Direct light by the `lobes` method ([`lobes::render_simd`], or [`lobes::render`]
+/// without `o.simd`, with its footprint refinement at `o.direct.footprint`) plus one bounce
+/// from HVLs at pixel centres, the indirect light interpolated on a [`lattice::Lattice`] of
+/// spacing `o.stride` when it is above 1 (indirect light from hundreds of HVLs varies
+/// slowly across a surface: each HVL's share is smooth in the receiver's position and
+/// normal, and the glossy parts are band-limited by their SH tables; so a pixel's mean
+/// takes its centre's); returns the image and the HVL count.
 pub fn render(scene: &Scene, o: &Options, bar: &ProgressBar) -> (Image, usize) {
     let at = Placement::new(scene, place(scene, o.side));
     let glossy = Glossy::of(scene, o);
@@ -896,23 +897,22 @@ pub fn render(scene: &Scene, o: &Options, bar: &ProgressBar) -> (Image, usize) {
             indirect(scene, p, &at, o, &glossy, scratch)
         })
     });
-    let new_state = || (ProductCounts::default(), Scratch::default());
+    let hidden = ProgressBar::hidden();
+    let (direct, _) = if o.simd {
+        lobes::render_simd(scene, &o.direct, &hidden)
+    } else {
+        lobes::render(scene, &o.direct, &hidden)
+    };
+    let width = scene.camera.width as usize;
     let (img, _, _) =
-        super::render_centres_x8_at(scene, bar, new_state, |(counts, scratch), pix, ps, out| {
-            if o.simd {
-                // The direct light by the `lobes` method's SIMD path, eight points at a time.
-                lobes::shade_x8(scene, ps, &o.direct, counts, out);
-            } else {
-                for (p, d) in ps.iter().zip(out.iter_mut()) {
-                    *d = lobes::shade(scene, p, &o.direct, counts);
-                }
-            }
+        super::render_centres_x8_at(scene, bar, Scratch::default, |scratch, pix, ps, out| {
             for ((&(i, j), p), d) in pix.iter().zip(ps).zip(out.iter_mut()) {
                 let ind = lattice
                     .as_ref()
                     .and_then(|l| l.interpolate(i, j, p))
                     .unwrap_or_else(|| indirect(scene, p, &at, o, &glossy, scratch));
-                *d = [d[0] + ind[0], d[1] + ind[1], d[2] + ind[2]];
+                let dl = direct.data[j * width + i];
+                *d = [dl[0] + ind[0], dl[1] + ind[1], dl[2] + ind[2]];
             }
         });
     (img, at.placed.len())

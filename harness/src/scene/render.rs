@@ -381,9 +381,9 @@ pub fn plan(scene: &Scene, o: &Options) -> Result<Plan, String> {
                     steradian_core::lobe::cap::MOMENTS_MAX_X
                 ),
             });
-            // `hvl` adds its indirect light at pixel centres: no refinement there (its wgpu
-            // path would refine the direct light alone).
-            if o.method == Method::Lobes {
+            // `hvl` refines its direct light alone, on every path: its indirect light
+            // varies slowly across a pixel (the premise of its lattice).
+            {
                 // Three significant digits: the plan prints it.
                 let t = super::footprint::LOBES_PLAN_FACTOR * o.target_error;
                 lo.footprint = format!("{t:.2e}").parse().unwrap_or(t);
@@ -391,8 +391,14 @@ pub fn plan(scene: &Scene, o: &Options) -> Result<Plan, String> {
                     lo.footprint,
                     super::footprint::LOBES_PLAN_FACTOR,
                     o.target_error,
-                    "highlights, shadow edges and the rims of spheres (the method's own \
-                     error at pixel centres is a fraction of the target)",
+                    if o.method == Method::Lobes {
+                        "highlights, shadow edges and the rims of spheres (the method's own \
+                         error at pixel centres is a fraction of the target)"
+                    } else {
+                        "the direct light's highlights, shadow edges and the rims of spheres \
+                         (the lobes method's rule); the indirect light is added at pixel \
+                         centres, where it varies slowly"
+                    },
                 ));
             }
             p.push(PlanItem {
