@@ -450,9 +450,9 @@ pub fn render_centres_x8_at<S: Send>(
 
 /// The share of `--target-error` each planned setting may add to a render ([`rsl::choose_k`],
 /// [`hvl::choose_side`], [`lobes::choose_depth`]; the pruning threshold takes a tenth). The
-/// methods' own models take most of the rest (on `cluster` the lobe model alone errs by
-/// most of the default target at every depth), so a setting gets a quarter, not a half; the
-/// plan tests assert what each share buys.
+/// methods' own models and pixel footprints take the rest, so a setting gets a quarter, not
+/// a half (the report's `scenes` rows give each method's error at its default point beside
+/// the target); the plan tests assert what each share buys.
 pub const PLAN_SHARE: f64 = 0.25;
 
 /// Probe pixels per image side of the plans' choices ([`rsl::choose_k`],
