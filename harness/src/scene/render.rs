@@ -156,8 +156,10 @@ fn footprint_item(value: f64, factor: f64, target: f64, what: &str) -> PlanItem 
         reason: format!(
             "pixels whose centre alone is estimated to miss the pixel's mean (the path tracer's \
              box filter) by {factor:.2} times the target {target} of the maximum or more, from \
-             the image's Laplacian over neighbours on the same object (|Δf|/24), are re-shaded \
-             at the 2×2 Gauss–Legendre points of the pixel and averaged: {what}"
+             the image's Laplacian over neighbours on the same object (|Δf|/24), and every \
+             pixel of an object fewer than {small} pixel centres see, are re-shaded at the 2×2 \
+             Gauss–Legendre points of the pixel and averaged: {what}",
+            small = super::footprint::SMALL_OBJECT_PIXELS
         ),
     }
 }
