@@ -322,11 +322,13 @@ pub enum Seen {
 pub type Objects = Vec<Option<usize>>;
 
 /// [`Objects`] of the pixels of a [`centre_queue`]: `pixels` of them in all, those in
-/// `queue` on their surface's object.
+/// `queue` on their surface's object (a queued index past `pixels` is left out).
 pub fn queue_objects(pixels: usize, queue: &[(usize, ShadingPoint)]) -> Objects {
     let mut objects = vec![None; pixels];
     for (k, p) in queue {
-        objects[*k] = Some(p.object);
+        if let Some(o) = objects.get_mut(*k) {
+            *o = Some(p.object);
+        }
     }
     objects
 }
