@@ -98,8 +98,8 @@ pub fn footprint_estimates(img: &Image, objects: &[Option<usize>]) -> Vec<Option
 
 /// Re-shades the pixels of `img` (its centre pass's [`super::Objects`] in `objects`) whose
 /// estimated footprint term reaches `threshold` times the image's largest surface value
-/// (module docs) at their 2×2 Gauss–Legendre points,
-/// through `shade` (any number of surface points in, one radiance each out, in order);
+/// (module docs), and every pixel of an object fewer than [`SMALL_OBJECT_PIXELS`] centres
+/// see, at their 2×2 Gauss–Legendre points, through `shade` (any number of surface points in, one radiance each out, in order);
 /// a point that sees no surface takes the radiance it sees. Returns the number of pixels
 /// re-shaded. Nothing is re-shaded for a `threshold` that is not positive.
 ///
