@@ -99,8 +99,9 @@ pub fn footprint_estimates(img: &Image, objects: &[Option<usize>]) -> Vec<Option
 /// Re-shades the pixels of `img` (its centre pass's [`super::Objects`] in `objects`) whose
 /// estimated footprint term reaches `threshold` times the image's largest surface value
 /// (module docs), and every pixel of an object fewer than [`SMALL_OBJECT_PIXELS`] centres
-/// see, at their 2×2 Gauss–Legendre points, through `shade` (any number of surface points in, one radiance each out, in order);
-/// a point that sees no surface takes the radiance it sees. Returns the number of pixels
+/// see, at their 2×2 Gauss–Legendre points, through `shade` (any number of surface points
+/// in, one radiance each out, in order); a point that sees no surface takes the radiance it
+/// sees. Returns the number of pixels
 /// re-shaded. Nothing is re-shaded for a `threshold` that is not positive.
 ///
 /// Errors: `shade`'s, or a `shade` that returns another count than it was given.
@@ -128,11 +129,10 @@ pub fn refine(
         *size.entry(*o).or_insert(0) += 1;
     }
     let small = |k: usize| {
-        objects
-            .get(k)
-            .copied()
-            .flatten()
-            .is_some_and(|o| size.get(&o).is_some_and(|&n| n < SMALL_OBJECT_PIXELS))
+        let object = objects.get(k).copied().flatten();
+        object
+            .and_then(|o| size.get(&o))
+            .is_some_and(|&n| n < SMALL_OBJECT_PIXELS)
     };
     let chosen: Vec<usize> = (0..est.len())
         .filter(|&k| est[k].is_some_and(|e| e > 0.0 && e >= threshold * max) || small(k))
@@ -189,6 +189,37 @@ pub fn refine(
 mod tests {
     use super::*;
 
+    /// Every surface pixel of `scene`'s image on one object (none small), `None` elsewhere.
+    fn one_object(scene: &Scene) -> Vec<Option<usize>> {
+        let cam = scene.camera;
+        (0..cam.pixels())
+            .map(|k| {
+                let (i, j) = (
+                    (k % cam.width as usize) as u32,
+                    (k / cam.width as usize) as u32,
+                );
+                matches!(scene.see(&cam.centre_ray(i, j)), Seen::Surface(_)).then_some(0)
+            })
+            .collect()
+    }
+
+    /// [`refine`] with every point shaded `v`: the pixels re-shaded and the points given.
+    fn refine_to(
+        scene: &Scene,
+        img: &mut Image,
+        objects: &[Option<usize>],
+        threshold: f64,
+        v: f64,
+    ) -> (usize, usize) {
+        let mut given = 0;
+        let n = refine(scene, img, objects, threshold, |pts| {
+            given = pts.len();
+            Ok(vec![[v; 3]; pts.len()])
+        })
+        .unwrap();
+        (n, given)
+    }
+
     /// The contract of [`refine`] on a small `lobes` scene: a flat image re-shades nothing
     /// (the shading closure is not called), nor does a threshold that is not positive; a
     /// step across the image re-shades exactly the surface pixels beside it whose
@@ -205,11 +236,7 @@ mod tests {
             img.data.iter_mut().for_each(|p| *p = [v; 3]);
             img
         };
-        // Every surface one object, so that none is small.
-        let objects: Vec<Option<usize>> = crate::scene::centre_objects(&scene)
-            .into_iter()
-            .map(|o| o.map(|_| 0))
-            .collect();
+        let objects = one_object(&scene);
         let never = |_: &[ShadingPoint]| -> Result<Vec<Rgb>, String> {
             panic!("nothing should be re-shaded")
         };
@@ -236,12 +263,7 @@ mod tests {
         assert!(!want.is_empty());
         assert!(want.iter().all(|&k| k % w == 11 || k % w == 12), "{want:?}");
         let mut refined = step.clone();
-        let mut given = 0;
-        let n = refine(&scene, &mut refined, &objects, 0.01, |pts| {
-            given = pts.len();
-            Ok(vec![[8.0; 3]; pts.len()])
-        })
-        .unwrap();
+        let (n, given) = refine_to(&scene, &mut refined, &objects, 0.01, 8.0);
         assert_eq!(n, want.len());
         assert!(given <= 4 * n && given > 0, "{given} points for {n} pixels");
         for k in 0..w * h {
@@ -271,10 +293,7 @@ mod tests {
         scene.camera = scene.camera.resized(24).unwrap();
         let (w, h) = (scene.camera.width as usize, scene.camera.height as usize);
         // Every surface one large object but for a 3 × 2 block, a small object of its own.
-        let mut objects: Vec<Option<usize>> = crate::scene::centre_objects(&scene)
-            .into_iter()
-            .map(|o| o.map(|_| 0))
-            .collect();
+        let mut objects = one_object(&scene);
         let small = usize::MAX;
         let block: Vec<usize> = (10..12)
             .flat_map(|j| (8..11).map(move |i| j * w + i))
@@ -285,12 +304,7 @@ mod tests {
         }
         let mut img = Image::new(w, h);
         img.data.iter_mut().for_each(|p| *p = [1.0; 3]);
-        let mut given = 0;
-        let n = refine(&scene, &mut img, &objects, 1e-3, |pts| {
-            given = pts.len();
-            Ok(vec![[3.0; 3]; pts.len()])
-        })
-        .unwrap();
+        let (n, given) = refine_to(&scene, &mut img, &objects, 1e-3, 3.0);
         assert_eq!(n, block.len());
         assert!(given <= 4 * n && given > 0, "{given} points for {n} pixels");
         for k in 0..w * h {

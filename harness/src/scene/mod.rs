@@ -333,21 +333,6 @@ pub fn queue_objects(pixels: usize, queue: &[(usize, ShadingPoint)]) -> Objects 
     objects
 }
 
-/// [`Objects`] cast afresh, for an image that comes without them.
-pub fn centre_objects(scene: &Scene) -> Objects {
-    let cam = scene.camera;
-    let (w, h) = (cam.width as usize, cam.height as usize);
-    (0..w * h)
-        .into_par_iter()
-        .map(
-            |k| match scene.see(&cam.centre_ray((k % w) as u32, (k / w) as u32)) {
-                Seen::Surface(p) => Some(p.object),
-                Seen::Radiance(_) => None,
-            },
-        )
-        .collect()
-}
-
 /// The image of the pixel-centre rays, rows in parallel: a light or the environment as
 /// seen, a surface by `shade(state, point)`. Each row gets a fresh `new_state()` (scratch
 /// buffers, counters), returned row by row with the image and its [`Objects`].
