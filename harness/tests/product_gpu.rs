@@ -171,8 +171,8 @@ fn lobe_product_bad_shapes() {
 /// `LobeSum::push_times_cosine_with` on the light's lobe, then `sum::triple_with`
 /// unshadowed and shadowed), with the built-in product table, its rows laid out by
 /// `lobes::chain_row` as the method lays them out: random normals, cap lobes of 1e-4 to
-/// 1.5 rad (energy-preserving and moments fits), diffuse and glossy reflectances (exponents 0 to 1e5), 0 to 6
-/// visibility lobes, thresholds 0 and 1e-4, plus the named hard cases (no visibility lobe,
+/// 1.5 rad (energy-preserving and moments fits), diffuse and glossy reflectances
+/// (exponents 0 to 1e5), 0 to 6 visibility lobes, thresholds 0 and 1e-4, plus the named hard cases (no visibility lobe,
 /// the light straight below the normal, a glossy lobe of exponent 0 and of 1e5). Each
 /// value within `LOBE_CHAIN_REL_TOL` of the chain's scale `|u|·(1 + Σ|w_k|)` plus, with a
 /// threshold, `(k + 1)·t·|u|` (a term at the threshold may be kept on one side only), the

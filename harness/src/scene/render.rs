@@ -385,24 +385,22 @@ pub fn plan(scene: &Scene, o: &Options) -> Result<Plan, String> {
             });
             // `hvl` refines its direct light alone, on every path: its indirect light
             // varies slowly across a pixel (the premise of its lattice).
-            {
-                // Three significant digits: the plan prints it.
-                let t = super::footprint::LOBES_PLAN_FACTOR * o.target_error;
-                lo.footprint = format!("{t:.2e}").parse().unwrap_or(t);
-                p.push(footprint_item(
-                    lo.footprint,
-                    super::footprint::LOBES_PLAN_FACTOR,
-                    o.target_error,
-                    if o.method == Method::Lobes {
-                        "highlights, shadow edges and the rims of spheres (the method's own \
-                         error at pixel centres is a fraction of the target)"
-                    } else {
-                        "the direct light's highlights, shadow edges and the rims of spheres \
-                         (the lobes method's rule); the indirect light is added at pixel \
-                         centres, where it varies slowly"
-                    },
-                ));
-            }
+            // Three significant digits: the plan prints it.
+            let t = super::footprint::LOBES_PLAN_FACTOR * o.target_error;
+            lo.footprint = format!("{t:.2e}").parse().unwrap_or(t);
+            p.push(footprint_item(
+                lo.footprint,
+                super::footprint::LOBES_PLAN_FACTOR,
+                o.target_error,
+                if o.method == Method::Lobes {
+                    "highlights, shadow edges and the rims of spheres (the method's own \
+                     error at pixel centres is a fraction of the target)"
+                } else {
+                    "the direct light's highlights, shadow edges and the rims of spheres \
+                     (the lobes method's rule); the indirect light is added at pixel \
+                     centres, where it varies slowly"
+                },
+            ));
             p.push(PlanItem {
                 item: "diffuse_term".into(),
                 value: json!("closed form × visible fraction"),
