@@ -881,8 +881,8 @@ pub fn choose_stride(scene: &Scene, o: &Options, target: f64) -> StrideChoice {
     StrideChoice { stride, estimates }
 }
 
-/// Direct light by the `lobes` method ([`lobes::render_simd`], or [`lobes::render`]
-/// without `o.simd`, with its footprint refinement at `o.direct.footprint`) plus one bounce
+/// Direct light by the `lobes` method ([`lobes::shade_x8`], or [`lobes::shade`] without
+/// `o.simd`, refined at `o.direct.footprint` by [`lobes::refine_image`]) plus one bounce
 /// from HVLs at pixel centres, the indirect light interpolated on a [`lattice::Lattice`] of
 /// spacing `o.stride` when it is above 1 (indirect light from hundreds of HVLs varies
 /// slowly across a surface: each HVL's share is smooth in the receiver's position and
@@ -897,24 +897,38 @@ pub fn render(scene: &Scene, o: &Options, bar: &ProgressBar) -> (Image, usize) {
             indirect(scene, p, &at, o, &glossy, scratch)
         })
     });
-    let hidden = ProgressBar::hidden();
-    let (direct, _) = if o.simd {
-        lobes::render_simd(scene, &o.direct, &hidden)
-    } else {
-        lobes::render(scene, &o.direct, &hidden)
-    };
     let width = scene.camera.width as usize;
-    let (img, _, _) =
-        super::render_centres_x8_at(scene, bar, Scratch::default, |scratch, pix, ps, out| {
-            for ((&(i, j), p), d) in pix.iter().zip(ps).zip(out.iter_mut()) {
-                let ind = lattice
+    // One centre pass: the direct light into the image, each pixel's indirect light beside
+    // it (row by row); the direct light refined, then the indirect light added.
+    let new_state = || (ProductCounts::default(), Scratch::default(), Vec::new());
+    let (mut img, rows, objects) = super::render_centres_x8_at(
+        scene,
+        bar,
+        new_state,
+        |(counts, scratch, ind), pix, ps, out| {
+            if o.simd {
+                lobes::shade_x8(scene, ps, &o.direct, counts, out);
+            } else {
+                for (p, d) in ps.iter().zip(out.iter_mut()) {
+                    *d = lobes::shade(scene, p, &o.direct, counts);
+                }
+            }
+            for (&(i, j), p) in pix.iter().zip(ps) {
+                let v = lattice
                     .as_ref()
                     .and_then(|l| l.interpolate(i, j, p))
                     .unwrap_or_else(|| indirect(scene, p, &at, o, &glossy, scratch));
-                let dl = direct.data[j * width + i];
-                *d = [dl[0] + ind[0], dl[1] + ind[1], dl[2] + ind[2]];
+                ind.push((j * width + i, v));
             }
-        });
+        },
+    );
+    lobes::refine_image(scene, &mut img, &objects, &o.direct, o.simd);
+    for (_, _, ind) in rows {
+        for (k, v) in ind {
+            let d = &mut img.data[k];
+            *d = [d[0] + v[0], d[1] + v[1], d[2] + v[2]];
+        }
+    }
     (img, at.placed.len())
 }
 

@@ -949,19 +949,33 @@ pub fn render(scene: &Scene, o: &Options, bar: &ProgressBar) -> (Image, ProductC
             shade(scene, p, o, counts)
         });
     let mut total = sum_counts(rows);
-    refine(
-        scene,
-        &mut img,
-        &objects,
-        o,
-        &mut total,
-        |points, counts, out| {
+    total += refine_image(scene, &mut img, &objects, o, false);
+    (img, total)
+}
+
+/// The footprint refinement of a `lobes` image `img` (its centre pass's `objects`) at
+/// `o.footprint`, the points shaded by [`shade_x8`], or by [`shade`] one at a time without
+/// `simd`; the products computed for it.
+pub fn refine_image(
+    scene: &Scene,
+    img: &mut Image,
+    objects: &[Option<usize>],
+    o: &Options,
+    simd: bool,
+) -> ProductCounts {
+    let mut total = ProductCounts::default();
+    if simd {
+        refine(scene, img, objects, o, &mut total, |points, counts, out| {
+            shade_x8(scene, points, o, counts, out)
+        });
+    } else {
+        refine(scene, img, objects, o, &mut total, |points, counts, out| {
             for (p, v) in points.iter().zip(out.iter_mut()) {
                 *v = shade(scene, p, o, counts);
             }
-        },
-    );
-    (img, total)
+        });
+    }
+    total
 }
 
 fn sum_counts(rows: impl IntoIterator<Item = ProductCounts>) -> ProductCounts {
@@ -1010,13 +1024,6 @@ pub fn render_simd(scene: &Scene, o: &Options, bar: &ProgressBar) -> (Image, Pro
             shade_x8(scene, ps, o, counts, out)
         });
     let mut total = sum_counts(rows);
-    refine(
-        scene,
-        &mut img,
-        &objects,
-        o,
-        &mut total,
-        |points, counts, out| shade_x8(scene, points, o, counts, out),
-    );
+    total += refine_image(scene, &mut img, &objects, o, true);
     (img, total)
 }
