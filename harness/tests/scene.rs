@@ -1611,8 +1611,8 @@ fn hvl_plans_the_indirect_lattice_from_the_target_error() {
     // and not on others'), so only the rule of the choice is asserted.
     assert_eq!(c.estimates.last().map(|x| x.0), Some(1));
     assert_first_within(&c.estimates, c.stride, target);
-    // The README's figure: spacing 3 on `room` at 64 columns.
-    assert_eq!((planned.stride, c.stride), (3, 3));
+    // The README's figure: spacing 2 on `room` at 64 columns.
+    assert_eq!((planned.stride, c.stride), (2, 2));
     let hidden = ProgressBar::hidden();
     let strided = hvl::render(&small.scene, &planned, &hidden).0;
     let every = hvl::render(

@@ -25,8 +25,8 @@
 //! ([`Options::visibility`]), which the harness measures on the `room` scene.
 //!
 //! **Lattice** (not in the paper). The indirect light is computed on a lattice of every
-//! [`Options::stride`]-th pixel and interpolated between on the same object and normal
-//! ([`super::lattice`]); the plan takes the coarsest spacing whose probes stay within its
+//! [`Options::stride`]-th pixel, split where a cell's corners differ, and interpolated
+//! between on the same object and normal ([`super::lattice`]); the plan takes the coarsest spacing whose probes stay within its
 //! share of the target ([`choose_stride`]). `stride = 1` is the paper's every pixel.
 
 use std::f64::consts::FRAC_PI_2;

@@ -591,8 +591,10 @@ pub fn plan(scene: &Scene, o: &Options) -> Result<Plan, String> {
                             } else {
                                 format!(
                                     "the indirect light computed every {} pixels across and \
-                                     down and interpolated between on the same object and \
-                                     normal (scene::lattice)",
+                                     down, more densely where a cell's corners differ in \
+                                     object, normal or value by more than half, and \
+                                     interpolated between on the same object and normal \
+                                     (scene::lattice)",
                                     hv.stride
                                 )
                             },
