@@ -20,19 +20,26 @@
 //! touch (`angle(a_j, centre) > β_j + γ`, `γ` the cell's angular radius) or that lies
 //! wholly outside the light's cap is not considered. Any other cell is subdivided, down to
 //! `max_depth`, where a partially covered cell is dropped ([`Leaves::Aggressive`]), kept
-//! ([`Leaves::Conservative`]) — the paper's two choices — or kept when its centre is
-//! covered ([`Leaves::Centre`], the midpoint rule, this crate's default).
+//! ([`Leaves::Conservative`]) — the paper's two choices —, kept when its centre is
+//! covered ([`Leaves::Centre`], the midpoint rule), or kept scaled by the covered share of
+//! the directions of a 4 × 4 grid over it that lie in the light's cap
+//! ([`Leaves::Fraction`], this crate's default: the midpoint rule two levels finer,
+//! without the leaves two more levels would emit; the leaf's lobe product with the light
+//! stands for the light it covers, of which `f` is the occluded share).
 //!
 //! **Leaf lobes.** A leaf of half-side `s` centred at `c` (on the unit-distance plane) is
 //! bounded by the sphere of centre `c` and radius `√2·s`; its lobe is that sphere's cap
-//! as a lobe, like a light's (eq. 31–32), with scale `−w`.
+//! as a lobe, like a light's (eq. 31–32), with scale `−w·f`, `f` its covered fraction (1
+//! but for [`Leaves::Fraction`]'s partial leaves).
 //!
 //! **Weights.** The paper tuned `w` by hand per `dist` and depth (a first-level weight for
 //! a dark umbra, then each level against the previous). Here they are fitted once in the
 //! harness (`generate::mask_weights`) by least squares against exact visibility — the
-//! unoccluded fraction of the light's cap — over random occluder configurations, and
-//! committed as the table [`WEIGHT_TABLE_BYTES`] (`steradian tables --check`), read with
-//! linear interpolation in `ln dist` ([`weight`]).
+//! unoccluded fraction of the light's cap — over random occluder configurations, one set
+//! per deepest level (a mask cut at depth 2 has partial leaves at depth 2 that a deeper
+//! one subdivides), and committed as the table [`WEIGHT_TABLE_BYTES`]
+//! (`steradian tables --check`), read with linear interpolation in `ln dist`
+//! ([`weight`]).
 
 use crate::Vec3;
 use crate::lobe::cap::SphericalCap;
@@ -47,8 +54,13 @@ pub const WEIGHT_DEPTHS: usize = MAX_DEPTH as usize + 1;
 pub const WEIGHT_DISTS: usize = 12;
 /// The range of `dist` in the weight table (`α` from 82.9° to 0.9°); clamped outside.
 pub const WEIGHT_DIST_RANGE: (f32, f32) = (0.0625, 32.0);
-/// Number of weights: value `i + WEIGHT_DISTS·depth` is the weight at the `i`-th `dist`.
-pub const WEIGHT_LEN: usize = WEIGHT_DISTS * WEIGHT_DEPTHS;
+/// Number of weights: value `i + WEIGHT_DISTS·(depth + WEIGHT_DEPTHS·(max_depth − 1))` is
+/// the weight of a leaf at `depth` of a mask cut at `max_depth` (1 ..= [`MAX_DEPTH`]) at
+/// the `i`-th `dist`.
+pub const WEIGHT_LEN: usize = WEIGHT_DISTS * WEIGHT_DEPTHS * MAX_DEPTH as usize;
+/// The covered fraction of a [`Leaves::Fraction`] leaf is taken over `FRACTION_GRID²`
+/// directions.
+pub const FRACTION_GRID: usize = 4;
 /// Name of the weight table.
 pub const WEIGHT_TABLE_NAME: &str = "mask-weights";
 /// The committed weight table.
@@ -66,8 +78,12 @@ pub enum Leaves {
     /// Kept (shadow): the paper's conservative variant.
     Conservative,
     /// Kept when its centre direction is covered: the midpoint rule.
-    #[default]
     Centre,
+    /// Kept, its lobe scaled by the share of those of [`FRACTION_GRID`]² directions over it
+    /// (the centres of its sub-cells) within the light's cap that an occluder covers;
+    /// dropped where none is.
+    #[default]
+    Fraction,
 }
 
 /// `dist = 1/(2 tan α)` of a light cap of half-angle `α` (see the module docs).
@@ -75,15 +91,18 @@ pub fn dist_of(half_angle: f32) -> f32 {
     math::cosf(half_angle) / (2.0 * math::sinf(half_angle))
 }
 
-/// The fitted weight at `dist` and `depth`, interpolated linearly in `ln dist` (clamped to
-/// the table's range; a depth beyond [`MAX_DEPTH`] reads the deepest level).
-pub fn weight(table: &[f32], dist: f32, depth: u32) -> f32 {
+/// The fitted weight of a leaf at `depth` of a mask cut at `max_depth`, at `dist`,
+/// interpolated linearly in `ln dist` (clamped to the table's range; `max_depth` is clamped
+/// to `1 ..= MAX_DEPTH` and `depth` to `max_depth`).
+pub fn weight(table: &[f32], dist: f32, depth: u32, max_depth: u32) -> f32 {
     let (lo, hi) = WEIGHT_DIST_RANGE;
     let u = (math::logf(dist.clamp(lo, hi)) - math::logf(lo)) / (math::logf(hi) - math::logf(lo));
     let x = u * (WEIGHT_DISTS - 1) as f32;
     let i = (math::floorf(x) as usize).min(WEIGHT_DISTS - 2);
     let f = x - i as f32;
-    let row = WEIGHT_DISTS * (depth.min(MAX_DEPTH) as usize);
+    let max_depth = max_depth.clamp(1, MAX_DEPTH);
+    let row =
+        WEIGHT_DISTS * (depth.min(max_depth) as usize + WEIGHT_DEPTHS * (max_depth as usize - 1));
     let (a, b) = (table[row + i], table[row + i + 1]);
     a + f * (b - a)
 }
@@ -112,15 +131,16 @@ impl Square {
     }
 }
 
-/// Calls `leaf(cap, depth)` for every shadow leaf of the mask of `occluders` over `light`
-/// (see the module docs); returns the number of leaves. Occluder caps are given as seen
+/// Calls `leaf(cap, depth, fraction)` for every shadow leaf of the mask of `occluders` over
+/// `light` (see the module docs; `fraction` is 1 but for [`Leaves::Fraction`]'s partial
+/// leaves); returns the number of leaves. Occluder caps are given as seen
 /// from the shading point (the same origin as `light`); any subset may miss the light.
 pub fn shadow_leaves(
     light: &SphericalCap,
     occluders: &[SphericalCap],
     max_depth: u32,
     leaves: Leaves,
-    mut leaf: impl FnMut(SphericalCap, u32),
+    mut leaf: impl FnMut(SphericalCap, u32, f32),
 ) -> usize {
     let max_depth = max_depth.min(MAX_DEPTH);
     let h = light.axis();
@@ -161,9 +181,9 @@ pub fn shadow_leaves(
         0,
         max_depth,
         leaves,
-        &mut |c, d| {
+        &mut |c, d, f| {
             count += 1;
-            leaf(c, d)
+            leaf(c, d, f)
         },
     );
     count
@@ -186,7 +206,7 @@ fn visit(
     depth: u32,
     max_depth: u32,
     leaves: Leaves,
-    leaf: &mut impl FnMut(SphericalCap, u32),
+    leaf: &mut impl FnMut(SphericalCap, u32, f32),
 ) {
     let centre = sq.dir(p, q);
     let corners = [
@@ -209,7 +229,7 @@ fn visit(
     let mut touched = false;
     for o in occ {
         if corners.iter().all(|c| c.dot(o.axis) >= o.cos_b) {
-            emit(sq, (p, q, s), depth, leaf);
+            emit(sq, (p, q, s), depth, 1.0, leaf);
             return;
         }
         // Within reach of the occluder's cap: ∠(axis, centre) ≤ β + γ.
@@ -221,13 +241,42 @@ fn visit(
         return;
     }
     if depth >= max_depth {
-        let keep = match leaves {
-            Leaves::Aggressive => false,
-            Leaves::Conservative => true,
-            Leaves::Centre => occ.iter().any(|o| centre.dot(o.axis) >= o.cos_b),
+        let fraction = match leaves {
+            Leaves::Aggressive => 0.0,
+            Leaves::Conservative => 1.0,
+            Leaves::Centre => {
+                if occ.iter().any(|o| centre.dot(o.axis) >= o.cos_b) {
+                    1.0
+                } else {
+                    0.0
+                }
+            }
+            Leaves::Fraction => {
+                const N: usize = FRACTION_GRID;
+                let (mut lit, mut hit) = (0, 0);
+                for a in 0..N {
+                    for b in 0..N {
+                        let u = p + s * ((2 * a + 1) as f32 / N as f32 - 1.0);
+                        let v = q + s * ((2 * b + 1) as f32 / N as f32 - 1.0);
+                        let d = sq.dir(u, v);
+                        if d.dot(sq.h) < sq.cos_a {
+                            continue;
+                        }
+                        lit += 1;
+                        if occ.iter().any(|o| d.dot(o.axis) >= o.cos_b) {
+                            hit += 1;
+                        }
+                    }
+                }
+                if lit == 0 {
+                    0.0
+                } else {
+                    hit as f32 / lit as f32
+                }
+            }
         };
-        if keep {
-            emit(sq, (p, q, s), depth, leaf);
+        if fraction > 0.0 {
+            emit(sq, (p, q, s), depth, fraction, leaf);
         }
         return;
     }
@@ -251,13 +300,14 @@ fn emit(
     sq: &Square,
     (p, q, s): (f32, f32, f32),
     depth: u32,
-    leaf: &mut impl FnMut(SphericalCap, u32),
+    fraction: f32,
+    leaf: &mut impl FnMut(SphericalCap, u32, f32),
 ) {
     let c = sq.h + sq.t * p + sq.b * q;
     let d = c.length();
     let r = (core::f32::consts::SQRT_2 * s).min(0.999 * d);
     if let Ok(cap) = SphericalCap::from_sphere(Vec3::ZERO, c, r) {
-        leaf(cap, depth);
+        leaf(cap, depth, fraction);
     }
 }
 
@@ -303,50 +353,58 @@ mod tests {
     }
 
     /// Linear interpolation in `ln dist` is exact at the table's nodes, and clamps beyond
-    /// its range.
+    /// its range; each deepest level reads its own rows, a depth beyond it its last.
     #[test]
     fn weight_reproduces_the_nodes_and_clamps() {
         let (lo, hi) = WEIGHT_DIST_RANGE;
         let table: [f32; WEIGHT_LEN] = core::array::from_fn(|k| k as f32);
-        for d in 0..WEIGHT_DEPTHS {
-            for i in 0..WEIGHT_DISTS {
-                let u = i as f32 / (WEIGHT_DISTS - 1) as f32;
-                let dist = math::expf(math::logf(lo) + u * (math::logf(hi) - math::logf(lo)));
-                let want = (i + WEIGHT_DISTS * d) as f32;
-                let got = weight(&table, dist, d as u32);
-                assert!(
-                    (got - want).abs() < 1e-3,
-                    "node {i}, depth {d}: {got} vs {want}"
+        for m in 1..=MAX_DEPTH {
+            let base = WEIGHT_DISTS * WEIGHT_DEPTHS * (m as usize - 1);
+            for d in 0..=m as usize {
+                for i in 0..WEIGHT_DISTS {
+                    let u = i as f32 / (WEIGHT_DISTS - 1) as f32;
+                    let dist = math::expf(math::logf(lo) + u * (math::logf(hi) - math::logf(lo)));
+                    let want = (base + i + WEIGHT_DISTS * d) as f32;
+                    let got = weight(&table, dist, d as u32, m);
+                    assert!(
+                        (got - want).abs() < 1e-3,
+                        "node {i}, depth {d} of {m}: {got} vs {want}"
+                    );
+                }
+                let row = (base + WEIGHT_DISTS * d) as f32;
+                assert_eq!(weight(&table, lo / 10.0, d as u32, m), row);
+                assert_eq!(
+                    weight(&table, hi * 10.0, d as u32, m),
+                    row + (WEIGHT_DISTS - 1) as f32
                 );
             }
-            let row = (WEIGHT_DISTS * d) as f32;
-            assert_eq!(weight(&table, lo / 10.0, d as u32), row);
-            assert_eq!(
-                weight(&table, hi * 10.0, d as u32),
-                row + (WEIGHT_DISTS - 1) as f32
-            );
+            assert_eq!(weight(&table, lo, m + 1, m), weight(&table, lo, m, m));
         }
-        // A depth beyond the table reads the deepest level.
+        // A deepest level beyond the table reads the last one's rows, 0 the first's.
         assert_eq!(
-            weight(&table, lo, MAX_DEPTH + 3),
-            weight(&table, lo, MAX_DEPTH)
+            weight(&table, lo, 2, MAX_DEPTH + 3),
+            weight(&table, lo, 2, MAX_DEPTH)
         );
+        assert_eq!(weight(&table, lo, 0, 0), weight(&table, lo, 0, 1));
     }
 
     #[test]
     fn no_occluder_no_leaf_and_a_covering_occluder_one_leaf() {
         let light = SphericalCap::new(Vec3::Z, 0.1).unwrap();
-        assert_eq!(shadow_leaves(&light, &[], 5, Leaves::Centre, |_, _| {}), 0);
+        assert_eq!(
+            shadow_leaves(&light, &[], 5, Leaves::Centre, |_, _, _| {}),
+            0
+        );
         let big = SphericalCap::new(Vec3::Z, 0.5).unwrap();
         let mut depths = [0u32; 8];
-        let n = shadow_leaves(&light, &[big], 5, Leaves::Centre, |_, d| {
+        let n = shadow_leaves(&light, &[big], 5, Leaves::Centre, |_, d, _| {
             depths[d as usize] += 1
         });
         assert_eq!((n, depths[0]), (1, 1));
         // An occluder beside the light touches no cell.
         let away = SphericalCap::new(Vec3::X, 0.2).unwrap();
         assert_eq!(
-            shadow_leaves(&light, &[away], 5, Leaves::Centre, |_, _| {}),
+            shadow_leaves(&light, &[away], 5, Leaves::Centre, |_, _, _| {}),
             0
         );
     }
@@ -359,12 +417,48 @@ mod tests {
         let light = SphericalCap::new(Vec3::Z, 0.05).unwrap();
         let occ =
             SphericalCap::new(Vec3::new(1.0, 0.0, 0.0), core::f32::consts::FRAC_PI_2).unwrap();
-        let count = |l| shadow_leaves(&light, &[occ], 5, l, |_, _| {});
+        let count = |l| shadow_leaves(&light, &[occ], 5, l, |_, _, _| {});
         let (a, c, k) = (
             count(Leaves::Aggressive),
             count(Leaves::Centre),
             count(Leaves::Conservative),
         );
         assert!(a <= c && c <= k && a > 0, "{a} {c} {k}");
+    }
+
+    /// A hemisphere whose rim crosses the square along the line `p = 0.3·tan α` (about
+    /// `+z` the square's axes are `x` and `y`; the light's cap is the disc of radius
+    /// `tan α`), at depth 1: the two right cells are partial leaves. Of each one's 4 × 4
+    /// grid, 13 directions lie in the light's cap, and 9 of those right of the rim
+    /// (`f = 9/13 ≈ 0.69`, against the exact share `0.62` of the quarter disc), where the
+    /// midpoint rule keeps them whole and the left cells are dropped.
+    #[test]
+    fn fraction_leaves_count_the_covered_share() {
+        let alpha = 0.1f32;
+        let light = SphericalCap::new(Vec3::Z, alpha).unwrap();
+        let x0 = 0.3 * math::sinf(alpha) / math::cosf(alpha);
+        let occ = SphericalCap::new(
+            Vec3::new(1.0, 0.0, -x0).normalize(),
+            core::f32::consts::FRAC_PI_2,
+        )
+        .unwrap();
+        let leaves = |l| {
+            let mut got = [(0u32, 0.0f32); 8];
+            let n = shadow_leaves(&light, &[occ], 1, l, |_, d, f| {
+                if let Some(g) = got.iter_mut().find(|g| g.1 == 0.0) {
+                    *g = (d, f);
+                }
+            });
+            (n, got)
+        };
+        let (n, got) = leaves(Leaves::Fraction);
+        assert_eq!(
+            (n, &got[..3]),
+            (2, &[(1, 9.0 / 13.0), (1, 9.0 / 13.0), (0, 0.0)][..])
+        );
+        let (n, got) = leaves(Leaves::Centre);
+        assert_eq!((n, &got[..3]), (2, &[(1, 1.0), (1, 1.0), (0, 0.0)][..]));
+        assert_eq!(leaves(Leaves::Aggressive).0, 0);
+        assert_eq!(leaves(Leaves::Conservative).0, 2);
     }
 }

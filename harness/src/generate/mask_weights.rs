@@ -1,17 +1,18 @@
 //! The weights `w(dist, depth)` of the quadtree visibility mask
 //! (`steradian_core::lobe::mask`), fitted by least squares against exact visibility.
 //!
-//! For each `dist` sample (light half-angle `α = atan(1/(2·dist))`, axis `+z`) and
-//! [`CONFIGS`] seeded configurations of 1–4 occluder caps that overlap the light (radii
-//! `0.15α … 2α`, at most 1.5 rad): the mask is built at [`FIT_DEPTH`] levels with
-//! [`Leaves::Centre`]; `S_d` is the sum over its depth-`d` leaves of `∫ L·c_leaf / ∫ L`
-//! (the light lobe `L` and the leaf lobes energy-preserving, as the `lobes` method uses
-//! them; products by the built-in kernel); the exact occluded fraction `o*` of the light's
-//! cap comes from a 64 × 128 equal-solid-angle midpoint grid over it. The model's occluded
-//! fraction is `Σ_d w_d·S_d`, linear in the weights, so
-//! `min Σ_k (Σ_d w_d S_dk − o*_k)² + λ·Σ_d (w_d − 1)²` is one normal-equation solve per
-//! `dist` (`nalgebra`'s Cholesky; the small ridge `λ` = [`RIDGE`]·configs pulls a depth
-//! that no configuration reaches toward 1).
+//! For each deepest level `m` (1 ..= `MAX_DEPTH`), each `dist` sample (light half-angle
+//! `α = atan(1/(2·dist))`, axis `+z`) and [`CONFIGS`] seeded configurations of 1–4
+//! occluder caps that overlap the light (radii `0.15α … 2α`, at most 1.5 rad): the mask is
+//! built down to depth `m` with [`LEAVES`]; `S_d` is the sum over its depth-`d` leaves of
+//! `f·∫ L·c_leaf / ∫ L` (`f` the leaf's covered fraction; the light lobe `L` and the leaf
+//! lobes energy-preserving, as the `lobes` method uses them; products by the built-in
+//! kernel); the exact occluded fraction `o*` of the light's cap comes from a 64 × 128
+//! equal-solid-angle midpoint grid over it. The model's occluded fraction is
+//! `Σ_d w_d·S_d`, linear in the weights, so `min Σ_k (Σ_d w_d S_dk − o*_k)² + λ·Σ_d
+//! (w_d − 1)²` over `d ≤ m` is one normal-equation solve per `m` and `dist` (`nalgebra`'s
+//! Cholesky; the small ridge `λ` = [`RIDGE`]·configs pulls a depth that no configuration
+//! reaches toward 1); the rows of depths below `m` hold 1, unread.
 
 use std::f64::consts::TAU;
 
@@ -19,8 +20,8 @@ use nalgebra::{DMatrix, DVector};
 use steradian_core::Vec3;
 use steradian_core::lobe::cap::{CapFit, SphericalCap};
 use steradian_core::lobe::mask::{
-    Leaves, WEIGHT_DEPTHS, WEIGHT_DIST_RANGE, WEIGHT_DISTS, WEIGHT_LEN, WEIGHT_TABLE_NAME,
-    shadow_leaves,
+    Leaves, MAX_DEPTH, WEIGHT_DEPTHS, WEIGHT_DIST_RANGE, WEIGHT_DISTS, WEIGHT_LEN,
+    WEIGHT_TABLE_NAME, shadow_leaves,
 };
 use steradian_core::lobe::product;
 use steradian_core::table::{HEADER_LEN, Spec, encode_into};
@@ -29,8 +30,8 @@ use crate::rng::Rng;
 
 /// Configurations per `dist` sample.
 pub const CONFIGS: usize = 300;
-/// Depth of the masks the weights are fitted on (the `lobes` method's default).
-pub const FIT_DEPTH: u32 = 5;
+/// The leaf rule the weights are fitted for (the `lobes` method's default).
+pub const LEAVES: Leaves = Leaves::Fraction;
 /// Ridge toward `w = 1`, per configuration.
 pub const RIDGE: f64 = 1e-4;
 
@@ -76,8 +77,9 @@ pub fn occluded_fraction(alpha: f64, occ: &[(glam::DVec3, f64)]) -> f64 {
     hit as f64 / (nr * np) as f64
 }
 
-/// `S_d`: per depth, the summed `∫ L·c_leaf / ∫ L` of the mask's leaves.
-pub fn leaf_sums(alpha: f64, occ: &[(glam::DVec3, f64)]) -> [f64; WEIGHT_DEPTHS] {
+/// `S_d`: per depth, the summed `f·∫ L·c_leaf / ∫ L` of the leaves of the mask cut at
+/// `max_depth`.
+pub fn leaf_sums(alpha: f64, occ: &[(glam::DVec3, f64)], max_depth: u32) -> [f64; WEIGHT_DEPTHS] {
     let light = SphericalCap::new(Vec3::Z, alpha as f32).expect("valid light");
     let l = light.lobe(1.0, CapFit::EnergyPreserving);
     let caps: Vec<SphericalCap> = occ
@@ -86,42 +88,49 @@ pub fn leaf_sums(alpha: f64, occ: &[(glam::DVec3, f64)]) -> [f64; WEIGHT_DEPTHS]
         .collect();
     let mut s = [0.0; WEIGHT_DEPTHS];
     let total = l.integral() as f64;
-    shadow_leaves(&light, &caps, FIT_DEPTH, Leaves::Centre, |cap, d| {
+    shadow_leaves(&light, &caps, max_depth, LEAVES, |cap, d, f| {
         let c = cap.lobe(1.0, CapFit::EnergyPreserving);
-        s[d as usize] += product::product(&l, &c).integral() as f64 / total;
+        s[d as usize] += f64::from(f) * product::product(&l, &c).integral() as f64 / total;
     });
     s
 }
 
-/// The fitted weights, value `i + WEIGHT_DISTS·depth`.
+/// The fitted weights, value `i + WEIGHT_DISTS·(depth + WEIGHT_DEPTHS·(max_depth − 1))`
+/// (`steradian_core::lobe::mask::WEIGHT_LEN`).
 pub fn fit() -> Vec<f32> {
     let mut out = vec![1.0f32; WEIGHT_LEN];
-    for i in 0..WEIGHT_DISTS {
-        let alpha = (1.0 / (2.0 * dist_sample(i))).atan();
-        let mut rng = Rng::new(0x6d61_736b ^ ((i as u64) << 32));
-        let mut a = DMatrix::<f64>::zeros(CONFIGS, WEIGHT_DEPTHS);
-        let mut y = DVector::<f64>::zeros(CONFIGS);
-        for k in 0..CONFIGS {
-            let occ = configuration(alpha, &mut rng);
-            let s = leaf_sums(alpha, &occ);
-            for d in 0..WEIGHT_DEPTHS {
-                a[(k, d)] = s[d];
+    for m in 1..=MAX_DEPTH {
+        let (base, nd) = (
+            WEIGHT_DISTS * WEIGHT_DEPTHS * (m as usize - 1),
+            m as usize + 1,
+        );
+        for i in 0..WEIGHT_DISTS {
+            let alpha = (1.0 / (2.0 * dist_sample(i))).atan();
+            let mut rng = Rng::new(0x6d61_736b ^ ((i as u64) << 32));
+            let mut a = DMatrix::<f64>::zeros(CONFIGS, nd);
+            let mut y = DVector::<f64>::zeros(CONFIGS);
+            for k in 0..CONFIGS {
+                let occ = configuration(alpha, &mut rng);
+                let s = leaf_sums(alpha, &occ, m);
+                for d in 0..nd {
+                    a[(k, d)] = s[d];
+                }
+                y[k] = occluded_fraction(alpha, &occ);
             }
-            y[k] = occluded_fraction(alpha, &occ);
-        }
-        let lambda = RIDGE * CONFIGS as f64;
-        let mut n = a.transpose() * &a;
-        let mut rhs = a.transpose() * &y;
-        for d in 0..WEIGHT_DEPTHS {
-            n[(d, d)] += lambda;
-            rhs[d] += lambda;
-        }
-        let w = n
-            .cholesky()
-            .expect("the ridge makes the normal matrix positive definite")
-            .solve(&rhs);
-        for d in 0..WEIGHT_DEPTHS {
-            out[i + WEIGHT_DISTS * d] = w[d] as f32;
+            let lambda = RIDGE * CONFIGS as f64;
+            let mut n = a.transpose() * &a;
+            let mut rhs = a.transpose() * &y;
+            for d in 0..nd {
+                n[(d, d)] += lambda;
+                rhs[d] += lambda;
+            }
+            let w = n
+                .cholesky()
+                .expect("the ridge makes the normal matrix positive definite")
+                .solve(&rhs);
+            for d in 0..nd {
+                out[base + i + WEIGHT_DISTS * d] = w[d] as f32;
+            }
         }
     }
     out
@@ -132,14 +141,14 @@ pub fn generate() -> Vec<u8> {
     let values = fit();
     let spec = Spec {
         name: WEIGHT_TABLE_NAME,
-        rank: 2,
+        rank: 3,
         channels: 1,
-        dims: [WEIGHT_DISTS as u32, WEIGHT_DEPTHS as u32, 1, 1],
-        lo: [(WEIGHT_DIST_RANGE.0 as f64).ln(), 0.0, 0.0, 0.0],
+        dims: [WEIGHT_DISTS as u32, WEIGHT_DEPTHS as u32, MAX_DEPTH, 1],
+        lo: [(WEIGHT_DIST_RANGE.0 as f64).ln(), 0.0, 1.0, 0.0],
         hi: [
             (WEIGHT_DIST_RANGE.1 as f64).ln(),
             (WEIGHT_DEPTHS - 1) as f64,
-            1.0,
+            MAX_DEPTH as f64,
             1.0,
         ],
     };

@@ -197,7 +197,7 @@ impl Default for Options {
             footprint: 0.0,
             visibility: Visibility::Mask {
                 depth: mask::MAX_DEPTH,
-                leaves: Leaves::Centre,
+                leaves: Leaves::Fraction,
             },
             exact_diffuse: true,
             table: TableSize::BuiltIn,
@@ -536,9 +536,9 @@ fn visibility(rx: &Receiver, lit: &Lit<'_>, o: &Options) -> LobeVec {
                 || (lit.hidden.is_some() && rx.glossy.iter().next().is_none()) => {}
         Visibility::Mask { depth, leaves } => {
             let dist = mask::dist_of(lit.cap.half_angle());
-            mask::shadow_leaves(lit.cap, lit.occluders, depth, leaves, |leaf, d| {
-                let w = mask::weight(&mask::WEIGHTS, dist, d);
-                vis.lobes.push(leaf.lobe(-w, o.fit));
+            mask::shadow_leaves(lit.cap, lit.occluders, depth, leaves, |leaf, d, f| {
+                let w = mask::weight(&mask::WEIGHTS, dist, d, depth);
+                vis.lobes.push(leaf.lobe(-w * f, o.fit));
             });
         }
     }
