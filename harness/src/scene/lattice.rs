@@ -112,20 +112,13 @@ impl Cell {
             .flat_map(move |y| xs.into_iter().flatten().map(move |x| Cell { x, y }))
     }
 
-    /// The child holding pixel `(i, j)` (the later half at the shared middle pixel).
+    /// The child holding pixel `(i, j)`: of [`Cell::children`], the last that does (the
+    /// later half at the shared middle pixel).
     fn child_of(self, i: usize, j: usize) -> Cell {
-        let half = |(a, b): (usize, usize), v: usize| {
-            if b - a <= LEAF_SPACING {
-                (a, b)
-            } else {
-                let m = a + (b - a) / 2;
-                if v < m { (a, m) } else { (m, b) }
-            }
-        };
-        Cell {
-            x: half(self.x, i),
-            y: half(self.y, j),
-        }
+        self.children()
+            .filter(|c| (c.x.0..=c.x.1).contains(&i) && (c.y.0..=c.y.1).contains(&j))
+            .last()
+            .unwrap_or(self)
     }
 }
 
