@@ -444,8 +444,10 @@ pub fn plan(scene: &Scene, o: &Options) -> Result<Plan, String> {
                 item: "visibility".into(),
                 value: json!(format!("quadtree mask, depth {}", choice.depth)),
                 reason: format!(
-                    "section 5.3: one lobe per shadow leaf with the fitted weights w(dist, depth), \
-                     overlapping occluders counted once; {} is the shallowest depth that keeps \
+                    "section 5.3: one lobe per shadow leaf with the weights w(dist, depth) fitted \
+                     for the deepest level, overlapping occluders counted once, a partially \
+                     covered leaf at the deepest level scaled by the covered share of the lit \
+                     directions of a 4 × 4 grid over it; {} is the shallowest depth that keeps \
                      {} probe pixels within {} of the target {} of depth {} ({})",
                     choice.depth,
                     super::PROBES.0 * super::PROBES.1,
