@@ -170,16 +170,16 @@ fn lobe_product_bad_shapes() {
 /// `wgsl::LOBE_CHAIN` row by row against its scalar twin (the `lobes` method's chain:
 /// `LobeSum::push_times_cosine_with` on the light's lobe, then `sum::triple_with`
 /// unshadowed and shadowed), with the built-in product table, its rows laid out by
-/// `lobes::chain_row` as the method lays them out: random normals, cap lobes of 1e-4 to
-/// 1.5 rad (energy-preserving and moments fits), diffuse and glossy reflectances
-/// (exponents 0 to 1e5), 0 to 6 visibility lobes, thresholds 0 and 1e-4, plus the named hard cases (no visibility lobe,
-/// the light straight below the normal, a glossy lobe of exponent 0 and of 1e5). Each
-/// value within `LOBE_CHAIN_REL_TOL` of the chain's scale `|u|·(1 + Σ|w_k|)` plus, with a
-/// threshold, `(k + 1)·t·|u|` (a term at the threshold may be kept on one side only), the
-/// scale taken per unit of `1 + ln(1 + e_max)` (`e_max` the chain's largest exponent) as
-/// `LOBE_PRODUCT_TOL` is per unit of its logarithms (and `1e-30` absolutely, where `f32`
-/// results may be flushed); the products computed equal where the threshold is 0. The
-/// test prints the worst (lavapipe: 4.3e-6 without pruning).
+/// `lobes::chain_row` as the method lays them out: random normals, cap lobes of 1e-4 to 1.5
+/// rad (energy-preserving and moments fits), diffuse and glossy reflectances (exponents 0
+/// to 1e5), 0 to 6 visibility lobes, thresholds 0 and 1e-4, plus the named hard cases (no
+/// visibility lobe, the light straight below the normal, a glossy lobe of exponent 0 and of
+/// 1e5). Each value within `LOBE_CHAIN_REL_TOL` of the chain's scale `|u|·(1 + Σ|w_k|)`
+/// plus, with a threshold, `(k + 1)·t·|u|` (a term at the threshold may be kept on one side
+/// only), the scale taken per unit of `1 + ln(1 + e_max)` (`e_max` the chain's largest
+/// exponent) as `LOBE_PRODUCT_TOL` is per unit of its logarithms (and `1e-30` absolutely,
+/// where `f32` results may be flushed); the products computed equal where the threshold is
+/// 0. The test prints the worst (lavapipe: 4.3e-6 without pruning).
 #[test]
 fn lobe_chain_matches_the_scalar_chain_row_by_row() {
     use steradian_core::lobe::cap::{CapFit, SphericalCap};

@@ -26,8 +26,9 @@
 //!
 //! **Lattice** (not in the paper). The indirect light is computed on a lattice of every
 //! [`Options::stride`]-th pixel, split where a cell's corners differ, and interpolated
-//! between on the same object and normal ([`super::lattice`]); the plan takes the coarsest spacing whose probes stay within its
-//! share of the target ([`choose_stride`]). `stride = 1` is the paper's every pixel.
+//! between on the same object and normal ([`super::lattice`]); the plan takes the coarsest
+//! spacing whose probes stay within its share of the target ([`choose_stride`]).
+//! `stride = 1` is the paper's every pixel.
 
 use std::f64::consts::FRAC_PI_2;
 
@@ -691,14 +692,14 @@ fn gpu_sum_table(scene: &Scene, hvls: &[Placed], bands: usize, visibility: bool)
 /// [`render`] with the diffuse indirect light and the direct light on the wgpu backend: the
 /// direct light by the `lobes` method's wgpu path ([`lobes::render_gpu`], within
 /// `steradian_core::wgsl::LOBE_CHAIN_REL_TOL` of its scalar path), the receivers' glossy
-/// parts on the CPU as [`render`] computes them, and each receiver's
-/// diffuse sum over the HVLs by `steradian_core::wgsl::SH_HVL_SUM` ([`GPU_BATCH`] receivers
-/// per dispatch, the shadow rays against the scene's spheres and planes in `f32` from the
-/// CPU path's origin, skipping the object the HVL lies on: in `f32` a ray grazing a plane
-/// toward an HVL on it meets the plane before its end), times the receiver's diffuse
-/// albedo; it sums the receiver's own object's HVLs too, which the CPU skips
-/// ([`Placement`]: they send a rounding's worth). Each receiver's sum is within `steradian_core::wgsl::SH_HVL_SUM_TOL` of the
-/// CPU's wherever no shadow ray flips between `f32` and `f64` (harness test
+/// parts on the CPU as [`render`] computes them, and each receiver's diffuse sum over the
+/// HVLs by `steradian_core::wgsl::SH_HVL_SUM` ([`GPU_BATCH`] receivers per dispatch, the
+/// shadow rays against the scene's spheres and planes in `f32` from the CPU path's origin,
+/// skipping the object the HVL lies on: in `f32` a ray grazing a plane toward an HVL on it
+/// meets the plane before its end), times the receiver's diffuse albedo; it sums the
+/// receiver's own object's HVLs too, which the CPU skips ([`Placement`]: they send a
+/// rounding's worth). Each receiver's sum is within `steradian_core::wgsl::SH_HVL_SUM_TOL`
+/// of the CPU's wherever no shadow ray flips between `f32` and `f64` (harness test
 /// `hvl_gpu_path_matches_the_cpu_path` in `tests/scene.rs`). Every pixel is computed,
 /// whatever `o.stride` (the plan sets it to 1 with `--gpu`).
 ///

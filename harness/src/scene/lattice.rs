@@ -19,10 +19,8 @@
 //!
 //! Why split: a plain lattice interpolated pixels near an object's edge from the far
 //! corners of their cell, and missed the indirect light's contact shadows inside a cell.
-//! On `room` at 96 columns and spacing 4 (the `hvl` plan's default, against 4096 paths of
-//! one bounce), splitting took the tone-mapped RMSE from 0.0201 to 0.0149 for 926 computed
-//! pixels against 784 and 8–10 % more time (best of 9, one process each: 11.3 ms against
-//! 10.3–10.5 ms).
+//! The report's `room` rows give the split lattice's error and time at each spacing beside
+//! every pixel computed.
 //!
 //! Not for the `rsl` method's environment light, where a plain lattice was tried: on
 //! `environment` the city's sun casts sharp shadows on the floor, and the probes' estimate
@@ -41,20 +39,16 @@ pub const NORMAL_COS: f64 = 0.95;
 pub const MIN_WEIGHT: f64 = 0.5;
 
 /// Largest spread of a colour channel over a cell's corners, as a fraction of the channel's
-/// largest corner value, for the cell to stay whole. On `room` at spacing 4 (module docs),
-/// splitting on geometry alone gave an RMSE of 0.0156; a spread of 0.7, 0.5, 0.35 and 0.25
-/// gave 0.0152, 0.0149, 0.0148 and 0.0147, the last two for 3 % and 9 % more time.
+/// largest corner value, for the cell to stay whole (chosen on `room`: smaller spreads
+/// split more cells for little less error).
 pub const SPLIT_SPREAD: f64 = 0.5;
 
-/// The spacing cells are split down to. Down to 1 (every pixel of an edge computed), `room`
-/// at spacing 4 computed 1757 pixels against 929 for the same RMSE (0.0163 against 0.0162,
-/// both split on geometry alone, without the normal rule).
+/// The spacing cells are split down to (split to single pixels, an object's edge costs
+/// every pixel along it; pixels the rule refuses compute their own anyway).
 pub const LEAF_SPACING: usize = 2;
 
 /// The lattice spacings a plan tries, coarsest first (1 is every pixel): powers of two, so
-/// that splits land on [`LEAF_SPACING`]. On `room` (module docs) spacing 8 gave an RMSE of
-/// 0.0169 in 10.3 ms and spacing 3 0.0154 in 16.6 ms, against spacing 4's 0.0149 in 11.3
-/// ms: neither is offered.
+/// that splits land on [`LEAF_SPACING`].
 pub const STRIDE_CANDIDATES: [usize; 3] = [4, 2, 1];
 
 /// A node: the surface point its pixel centre sees and its value; `None` where it sees no
