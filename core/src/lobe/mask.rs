@@ -115,6 +115,13 @@ struct Occ {
     sin_b: f32,
 }
 
+impl Occ {
+    /// Whether the unit direction `d` lies in the cap.
+    fn holds(&self, d: Vec3) -> bool {
+        d.dot(self.axis) >= self.cos_b
+    }
+}
+
 /// The square's frame and extent for one light.
 #[derive(Clone, Copy, Debug)]
 struct Square {
@@ -228,7 +235,7 @@ fn visit(
     }
     let mut touched = false;
     for o in occ {
-        if corners.iter().all(|c| c.dot(o.axis) >= o.cos_b) {
+        if corners.iter().all(|&c| o.holds(c)) {
             emit(sq, (p, q, s), depth, 1.0, leaf);
             return;
         }
@@ -245,7 +252,7 @@ fn visit(
             Leaves::Aggressive => 0.0,
             Leaves::Conservative => 1.0,
             Leaves::Centre => {
-                if occ.iter().any(|o| centre.dot(o.axis) >= o.cos_b) {
+                if occ.iter().any(|o| o.holds(centre)) {
                     1.0
                 } else {
                     0.0
@@ -263,7 +270,7 @@ fn visit(
                             continue;
                         }
                         lit += 1;
-                        if occ.iter().any(|o| d.dot(o.axis) >= o.cos_b) {
+                        if occ.iter().any(|o| o.holds(d)) {
                             hit += 1;
                         }
                     }
@@ -460,5 +467,37 @@ mod tests {
         assert_eq!((n, &got[..3]), (2, &[(1, 1.0), (1, 1.0), (0, 0.0)][..]));
         assert_eq!(leaves(Leaves::Aggressive).0, 0);
         assert_eq!(leaves(Leaves::Conservative).0, 2);
+    }
+
+    /// Where the grid is exact: at depth 2 the rim `p = tan α/4` runs along a boundary of
+    /// the 4 × 4 grids of the cells `0 ≤ p ≤ tan α/2`, and the two of them with
+    /// `|q| ≤ tan α/2` lie wholly in the light's cap (their far corner at `0.71·tan α`),
+    /// so their `f` is their exact covered share, ½; the two beyond them count 7 of their
+    /// 15 lit directions, and the cells right of them are covered whole (`f = 1`).
+    #[test]
+    fn fraction_leaves_are_exact_where_the_rim_follows_the_grid() {
+        let alpha = 0.1f32;
+        let light = SphericalCap::new(Vec3::Z, alpha).unwrap();
+        let x0 = 0.25 * math::sinf(alpha) / math::cosf(alpha);
+        let occ = SphericalCap::new(
+            Vec3::new(1.0, 0.0, -x0).normalize(),
+            core::f32::consts::FRAC_PI_2,
+        )
+        .unwrap();
+        let (mut half, mut sevenths, mut whole, mut other) = (0, 0, 0, 0);
+        shadow_leaves(&light, &[occ], 2, Leaves::Fraction, |_, d, f| {
+            assert_eq!(d, 2);
+            if f == 0.5 {
+                half += 1;
+            } else if f == 7.0 / 15.0 {
+                sevenths += 1;
+            } else if f == 1.0 {
+                whole += 1;
+            } else {
+                other += 1;
+            }
+        });
+        assert_eq!((half, sevenths, other), (2, 2, 0));
+        assert!(whole >= 4, "{whole}");
     }
 }
