@@ -78,13 +78,25 @@
 //! on every instruction set (the bit-identical kernels use only correctly rounded
 //! operations); only the speed differs.
 //!
+//! ## One `unsafe` block
+//!
+//! The crate denies `unsafe` but for one function: [`rsl::sat`]'s table reads use
+//! AVX-512's 8-lane gather (`vpgatherqq`) where the build enables AVX-512F on x86-64.
+//! `wide` has no gather, and LLVM, which turns the plain lane loop into gathers, forms only
+//! 4-lane ones on current x86 cores (its preferred vector width there is 256 bits). The
+//! 8-lane gathers read the same entries with half the instructions (the report's `sat`
+//! section puts the query beside its load-only floor). Every index is clipped into the
+//! table just before the gather, in the same function (its `SAFETY` comment); the plain
+//! loop, used on every other target, is kept, and a test checks that the two read the same
+//! entries.
+//!
 //! ## Speed
 //!
 //! `cargo run --release -p steradian-simd --example speed` prints ns per element for the
 //! scalar kernel called per input behind `black_box`, a plain loop over the scalar kernel
 //! (which LLVM auto-vectorises where it can), and the slice functions.
 #![cfg_attr(not(test), no_std)]
-#![forbid(unsafe_code)]
+#![deny(unsafe_code)]
 #![warn(missing_docs)]
 
 pub mod batch;

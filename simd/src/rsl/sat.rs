@@ -2,9 +2,11 @@
 //!
 //! [`box_sum`] performs the operations of `steradian_core::rsl::sat::SatView::box_sum` lane-wise:
 //! the ordering and clipping of the corners with comparisons and selects, `floor`, the
-//! exact fractions, the sixteen table reads (eight adjacent pairs per lane, staged by a
-//! plain loop over the lanes, which the compiler turns into gathers where the target has
-//! them: `wide` has none; every index is clipped into the table, so they need no mask), the 27 exact `i64` subtractions in `i64x8`, the nine
+//! exact fractions, the sixteen table reads (eight adjacent pairs per lane: on x86-64 with
+//! AVX-512, sixteen 8-lane hardware gathers, the crate's one `unsafe` block, see
+//! [`gather`]; elsewhere a plain loop over the lanes, which the compiler turns into
+//! gathers where the target has them: `wide` has none; every index is clipped into the
+//! table, so they need no mask), the 27 exact `i64` subtractions in `i64x8`, the nine
 //! `i64 → f64` conversions, the `f64` combination in the scalar kernel's order (no fused
 //! multiply-add), the scaling by the quantum and the one rounding to `f32`. So every lane
 //! is **bit-identical** to the scalar kernel, NaN lanes included (NaN exactly where a
@@ -91,15 +93,15 @@ fn fractional(sat: &SatView<'_>, ij: [f32x8; 4], [a0, a1, b0, b1]: [f32x8; 4]) -
 /// Row offsets (`J0`, `J1`, `J0 + 1` or `J0`, `J1 + 1` or `J1`) and columns (`I0`, `I1`)
 /// of the sixteen entries of [`fractional`], from the indices `I0, I1, J0, J1` of [`axis`]
 /// (exact integers `0 ≤ I ≤ width − 1`, `0 ≤ J ≤ height − 1` in `f32` lanes, or NaN), in
-/// `i32` lanes: sides are at most `MAX_SIDE` = 2²⁴, so `width + 1` fits and a row offset
-/// `J·(width + 1)` is exact in the widening multiply's `i64`. A NaN lane's indices are
-/// clipped into the table: its result is NaN whatever it reads.
+/// `i64` lanes: sides are at most `MAX_SIDE` = 2²⁴, so `width + 1` fits in `i32` and a row
+/// offset `J·(width + 1)` is exact in the widening multiply's `i64`. A NaN lane's indices
+/// are clipped into the table: its result is NaN whatever it reads.
 #[inline(always)]
 fn entries(
     sat: &SatView<'_>,
     [i0, i1, j0, j1]: [f32x8; 4],
     [b0, b1]: [f32x8; 2],
-) -> ([[usize; 8]; 4], [[usize; 8]; 2]) {
+) -> ([i64x8; 4], [i64x8; 2]) {
     let side = |n: usize| i32x8::splat(n as i32);
     let (h, w1, wl) = (
         side(sat.height()),
@@ -107,9 +109,8 @@ fn entries(
         side(sat.width() - 1),
     );
     let index = |x: f32x8| x.fast_trunc_int().max(i32x8::ZERO);
-    let usizes = |x: i64x8| x.to_array().map(|v| v as usize);
     // Rows are at most `height` (`J ≤ height − 1`, so `J + 1 ≤ height`).
-    let row = |j: i32x8| usizes(j.min(h).widening_mul(w1));
+    let row = |j: i32x8| j.min(h).widening_mul(w1);
     // `J + 1` where the fraction is non-zero, else `J` again (exact: `J + 1 ≤ 2²⁴`).
     let next = |j: f32x8, b: f32x8| j + b.simd_ne(f32x8::ZERO).select(f32x8::ONE, f32x8::ZERO);
     let rows = [
@@ -118,27 +119,92 @@ fn entries(
         row(index(next(j0, b0))),
         row(index(next(j1, b1))),
     ];
-    let col = |i: f32x8| index(i).min(wl).to_array().map(|v| v as u32 as usize);
+    let col = |i: f32x8| index(i).min(wl).widening_mul(i32x8::ONE);
     (rows, [col(i0), col(i1)])
 }
 
-/// `st[4·row + col][lane]`: each row's two column pairs read as pairs. A column index is at
-/// most `width − 1` and a row at most `height`, so a pair starts at most two entries before
-/// the end of the table; the `min` only lets the compiler see it (no bounds check, no mask).
+/// `st[4·row + col]`: lane `k` of each row's two column pairs, entries `rows[r][k] +
+/// cols[c][k]` and the one after it. A column is at most `width − 1` and a row offset at
+/// most `height·(width + 1)`, so a pair starts at most two entries before the end of the
+/// table; the index is clipped into `0 ..= len − 2` as an unsigned integer all the same,
+/// so that reading the pair is in bounds whatever the lanes hold (a valid view's table
+/// holds at least 2 × 2 entries; one too small for a pair reads nothing).
+///
+/// On x86-64 with AVX-512 the sixteen reads are 8-lane hardware gathers
+/// ([`gather_avx512`]); elsewhere [`gather_lanes`], whose loop over the lanes LLVM turns
+/// into the target's gathers where it has them. It forms only 4-lane ones, even with
+/// AVX-512 (it prefers 256-bit vectors on current Intel cores), and the 8-lane gathers
+/// read the same entries with half the instructions.
 #[inline(always)]
-fn gather(sums: &[i64], rows: &[[usize; 8]; 4], cols: &[[usize; 8]; 2]) -> [[i64; 8]; 16] {
+fn gather(sums: &[i64], rows: &[i64x8; 4], cols: &[i64x8; 2]) -> [i64x8; 16] {
+    #[cfg(all(target_arch = "x86_64", target_feature = "avx512f"))]
+    {
+        gather_avx512(sums, rows, cols)
+    }
+    #[cfg(not(all(target_arch = "x86_64", target_feature = "avx512f")))]
+    {
+        gather_lanes(sums, rows, cols)
+    }
+}
+
+/// [`gather`] as a plain loop over the lanes.
+#[cfg_attr(
+    all(target_arch = "x86_64", target_feature = "avx512f"),
+    allow(dead_code)
+)]
+#[inline(always)]
+fn gather_lanes(sums: &[i64], rows: &[i64x8; 4], cols: &[i64x8; 2]) -> [i64x8; 16] {
     let mut st = [[0i64; 8]; 16];
-    // A valid view's table holds at least 2 × 2 entries.
     let Some(last) = sums.len().checked_sub(2) else {
-        return st;
+        return [i64x8::ZERO; 16];
     };
+    let (rows, cols) = (rows.map(|r| r.to_array()), cols.map(|c| c.to_array()));
     for k in 0..8 {
         for (r, rk) in rows.iter().enumerate() {
             for (c, ck) in cols.iter().enumerate() {
-                let at = (rk[k] + ck[k]).min(last);
+                // Clipped as unsigned, as `gather_avx512` does.
+                let at = (rk[k].wrapping_add(ck[k]) as u64).min(last as u64) as usize;
                 st[4 * r + 2 * c][k] = sums[at];
                 st[4 * r + 2 * c + 1][k] = sums[at + 1];
             }
+        }
+    }
+    st.map(i64x8::new)
+}
+
+/// [`gather`] with AVX-512's 8-lane `vpgatherqq`, two per row and column (the entry and
+/// the one after it, from the same index vector).
+#[cfg(all(target_arch = "x86_64", target_feature = "avx512f"))]
+#[allow(unsafe_code)]
+#[inline(always)]
+fn gather_avx512(sums: &[i64], rows: &[i64x8; 4], cols: &[i64x8; 2]) -> [i64x8; 16] {
+    use core::arch::x86_64::{__m512i, _mm512_i64gather_epi64};
+    use wide::u64x8;
+    let mut st = [i64x8::ZERO; 16];
+    let Some(last) = sums.len().checked_sub(2) else {
+        return st;
+    };
+    let last = u64x8::splat(last as u64);
+    for (r, rk) in rows.iter().enumerate() {
+        for (c, ck) in cols.iter().enumerate() {
+            // Clipped as unsigned: a negative lane reads as 2⁶³ or more, so it too
+            // becomes `last`.
+            let at = u64x8::from(__m512i::from(*rk + *ck)).min(last);
+            let at = __m512i::from(at);
+            let base = sums.as_ptr();
+            // SAFETY: every lane of `at` is in `0 ..= sums.len() − 2` (clipped just above),
+            // so both gathers read `sums[at]` and `sums[at + 1]` inside the slice; `base`
+            // and `base.add(1)` point into it (`sums.len() ≥ 2`); `i64` has no invalid
+            // values and no alignment beyond the slice's; the target has AVX-512F
+            // (`cfg` above).
+            let (lo, hi) = unsafe {
+                (
+                    _mm512_i64gather_epi64::<8>(at, base),
+                    _mm512_i64gather_epi64::<8>(at, base.add(1)),
+                )
+            };
+            st[4 * r + 2 * c] = i64x8::from(lo);
+            st[4 * r + 2 * c + 1] = i64x8::from(hi);
         }
     }
     st
@@ -147,8 +213,8 @@ fn gather(sums: &[i64], rows: &[[usize; 8]; 4], cols: &[[usize; 8]; 2]) -> [[i64
 /// The scalar kernel's 27 subtractions, nine conversions and `f64` combination on the
 /// entries `st` of [`gather`], in its order, then the quantum and the rounding to `f32`.
 #[inline(always)]
-fn combine(sat: &SatView<'_>, st: &[[i64; 8]; 16], [a0, a1, b0, b1]: [f32x8; 4]) -> f32x8 {
-    let row = |r: usize| -> [i64x8; 4] { core::array::from_fn(|c| i64x8::new(st[4 * r + c])) };
+fn combine(sat: &SatView<'_>, st: &[i64x8; 16], [a0, a1, b0, b1]: [f32x8; 4]) -> f32x8 {
+    let row = |r: usize| -> [i64x8; 4] { core::array::from_fn(|c| st[4 * r + c]) };
     let (r0, r1, r0p, r1p) = (row(0), row(1), row(2), row(3));
     let d = |l: [i64x8; 4], m: [i64x8; 4]| -> [i64x8; 3] {
         [
@@ -249,6 +315,36 @@ pub fn square_slices(sat: &SatView<'_>, cx: &[f32], cy: &[f32], r: &[f32], out: 
 mod tests {
     use super::*;
     use crate::lanes::tests::same;
+
+    /// The AVX-512 gathers read what the plain lane loop reads, for indices in the table,
+    /// at its last pair, beyond its end, wrapping and negative (both clip them as unsigned
+    /// integers: to the last pair),
+    /// and on a table too small to hold a pair (both read nothing).
+    #[cfg(all(target_arch = "x86_64", target_feature = "avx512f"))]
+    #[test]
+    fn avx512_gathers_read_what_the_lane_loop_reads() {
+        let sums: Vec<i64> = (0..40i64).map(|k| k * k * 7919 - 3 * k).collect();
+        let last = sums.len() as i64 - 2;
+        let picks = [0, 1, 5, last - 1, last, last + 1, i64::MAX, -1, i64::MIN];
+        for s in 0..picks.len() {
+            let lane = |k: usize, m: usize| picks[(s + k * m) % picks.len()];
+            let rows: [i64x8; 4] =
+                core::array::from_fn(|r| i64x8::new(core::array::from_fn(|k| lane(k, r + 1))));
+            // Columns are small and non-negative, as `entries` makes them, so a row's
+            // extreme values stay extreme in the sum.
+            let cols: [i64x8; 2] =
+                core::array::from_fn(|c| i64x8::new(core::array::from_fn(|k| (k + c) as i64)));
+            for table in [&sums[..], &sums[..2], &sums[..1], &[][..]] {
+                let (a, b) = (
+                    gather_avx512(table, &rows, &cols),
+                    gather_lanes(table, &rows, &cols),
+                );
+                for (x, y) in a.iter().zip(&b) {
+                    assert_eq!(x.to_array(), y.to_array(), "table of {}", table.len());
+                }
+            }
+        }
+    }
 
     #[test]
     fn lanes_match_scalar_on_special_corners() {
