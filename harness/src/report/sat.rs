@@ -3,6 +3,15 @@
 //! `f32` pairs, `f64`, and the `i64` fixed point of `steradian_core::rsl::sat`) at 64² … 2048²,
 //! bytes per option, build time and query throughput (scalar, SIMD, wgpu) with the
 //! baselines measured in the same run.
+//!
+//! The roofline puts the fractional box query beside its load-only floor: the sixteen `i64`
+//! entries it reads (eight adjacent pairs over four rows) in the same order, summed. The
+//! floor issues them as plain scalar loads; the SIMD query's gathers issue the same loads
+//! with fewer instructions, so it can come out slightly below the floor when both wait on
+//! DRAM (the cold runs). Only the layout moves the floor: fewer loads per box (rows `J` and
+//! `J + 1` interleaved, so that each 2 × 2 corner block is one 32-byte read, at twice the
+//! table's bytes), fewer lines per box (tiling the table so that a small box's rows share
+//! cache lines), or narrower entries (`i32` differences to a per-tile `i64` base).
 
 use std::error::Error;
 use std::fmt::Write as _;
