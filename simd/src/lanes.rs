@@ -8,7 +8,43 @@
 
 use core::ops::{Add, BitAnd, BitOr, Div, Mul, Neg, Not, Sub};
 
-use wide::{f32x8, f32x16, f64x8};
+use wide::{f32x8, f32x16, f64x8, i64x8, u64x8};
+
+/// `x as f64` lane-wise: the nearest `f64`, ties to even, for every `i64`, as the scalar
+/// kernels' `as f64`.
+///
+/// With AVX-512DQ one `vcvtqq2pd`; elsewhere (AVX2 has no such conversion, and `wide`
+/// converts lane by lane) with two exact conversions and one rounding: write the biased
+/// `x + 2⁶³ = h·2³² + l` (`h, l < 2³²`); the bit patterns `0x453…h` and `0x433…l` are
+/// `H = 2⁸⁴ + h·2³²` and `L = 2⁵² + l`, so `(H − (2⁸⁴ + 2⁶³ + 2⁵²)) + L = x`, where the
+/// subtraction is exact (its result `(h − 2³¹)·2³² − 2⁵²`, a multiple of 2³² below 2⁶⁴ in
+/// magnitude, needs at most 32 significant bits) and the addition is the one rounding.
+#[inline(always)]
+pub(crate) fn to_f64(x: i64x8) -> f64x8 {
+    #[cfg(all(target_arch = "x86_64", target_feature = "avx512dq"))]
+    {
+        x.round_float()
+    }
+    #[cfg(not(all(target_arch = "x86_64", target_feature = "avx512dq")))]
+    {
+        to_f64_split(x)
+    }
+}
+
+/// The split conversion of [`to_f64`] (also tested where `to_f64` does not use it).
+#[cfg_attr(
+    all(target_arch = "x86_64", target_feature = "avx512dq"),
+    allow(dead_code)
+)]
+#[inline(always)]
+pub(crate) fn to_f64_split(x: i64x8) -> f64x8 {
+    let u = bytemuck::cast::<i64x8, u64x8>(x) ^ u64x8::splat(1 << 63);
+    let h = u.unbounded_shr_scalar(32) | u64x8::splat(0x4530_0000_0000_0000);
+    let l = (u & u64x8::splat(0xffff_ffff)) | u64x8::splat(0x4330_0000_0000_0000);
+    // 2⁸⁴ + 2⁶³ + 2⁵² (the bits of 2⁸⁴·(1 + 2⁻²¹ + 2⁻³²)).
+    let c = f64x8::splat(f64::from_bits(0x4530_0000_8010_0000));
+    (bytemuck::cast::<u64x8, f64x8>(h) - c) + bytemuck::cast::<u64x8, f64x8>(l)
+}
 
 /// Eight `f32` lanes as `f64` (exact).
 #[inline(always)]
@@ -415,6 +451,46 @@ pub(crate) mod tests {
                 .wrapping_mul(6364136223846793005)
                 .wrapping_add(1442695040888963407);
             (s >> 40) as f32 / (1u64 << 24) as f32
+        }
+    }
+
+    /// The split `i64 → f64` conversion (and `to_f64`, whichever it uses) is `as f64` bit
+    /// for bit in every lane: the ends of the range, the powers of two and their
+    /// neighbours (where `f64` runs out of bits, ties included: 2⁵³ + 1 and 2⁶² + 2⁹ are
+    /// halfway cases), the split's own boundary (2³² ± 1) and random patterns.
+    #[test]
+    fn i64_to_f64_is_correctly_rounded_in_every_lane() {
+        let mut v = vec![0i64, 1, -1, i64::MAX, i64::MIN, i64::MIN + 1, i64::MAX - 1];
+        for e in 0..63 {
+            let p = 1i64 << e;
+            for d in [-3i64, -1, 0, 1, 3] {
+                v.extend([p.wrapping_add(d), p.wrapping_add(d).wrapping_neg()]);
+            }
+        }
+        v.extend([
+            (1i64 << 53) + 1,
+            (1i64 << 62) + (1 << 9),
+            (1i64 << 62) + (3 << 9),
+        ]);
+        let mut s = 0x9e37_79b9_7f4a_7c15u64;
+        for _ in 0..4000 {
+            s = s
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            // Random magnitudes: shift the pattern right by 0–63 bits.
+            v.push((s as i64) >> (s >> 58));
+        }
+        for (k, w) in v.chunks(8).enumerate() {
+            // Each value visits every lane across the rotations.
+            for r in 0..8 {
+                let x: [i64; 8] = core::array::from_fn(|l| w[(l + r + k) % w.len()]);
+                let want = x.map(|x| x as f64);
+                for got in [to_f64_split(i64x8::new(x)), to_f64(i64x8::new(x))] {
+                    for (g, (w, x)) in got.to_array().iter().zip(want.iter().zip(x)) {
+                        assert_eq!(g.to_bits(), w.to_bits(), "{x}: {g} vs {w}");
+                    }
+                }
+            }
         }
     }
 

@@ -78,17 +78,17 @@
 //! on every instruction set (the bit-identical kernels use only correctly rounded
 //! operations); only the speed differs.
 //!
-//! ## One `unsafe` block
+//! ## `unsafe` in one place
 //!
-//! The crate denies `unsafe` but for one function: [`rsl::sat`]'s table reads use
-//! AVX-512's 8-lane gather (`vpgatherqq`) where the build enables AVX-512F on x86-64.
-//! `wide` has no gather, and LLVM, which turns the plain lane loop into gathers, forms only
-//! 4-lane ones on current x86 cores (its preferred vector width there is 256 bits). The
-//! 8-lane gathers read the same entries with half the instructions (the report's `sat`
-//! section puts the query beside its load-only floor). Every index is clipped into the
-//! table just before the gather, in the same function (its `SAFETY` comment); the plain
-//! loop, used on every other target, is kept, and a test checks that the two read the same
-//! entries.
+//! The crate denies `unsafe` but for two functions of [`rsl::sat`]: its table reads use
+//! the hardware gathers (`vpgatherqq`), 8-lane with AVX-512F and 4-lane with AVX2, where
+//! the build enables them on x86-64. `wide` has no gather, and from the plain lane loop
+//! LLVM forms only 4-lane gathers with AVX-512 (its preferred vector width on current
+//! Intel cores is 256 bits) and none for AVX2 alone. The gathers read the same entries
+//! with far fewer instructions (the report's `sat` section puts the query beside its
+//! load-only floor). Every index is clipped into the table just before the gather, in
+//! the same function (its `SAFETY` comment); the plain loop, used on every other target,
+//! is kept, and a test checks that the gathers read what it reads.
 //!
 //! ## Speed
 //!

@@ -2,11 +2,10 @@
 //!
 //! [`box_sum`] performs the operations of `steradian_core::rsl::sat::SatView::box_sum` lane-wise:
 //! the ordering and clipping of the corners with comparisons and selects, `floor`, the
-//! exact fractions, the sixteen table reads (eight adjacent pairs per lane: on x86-64 with
-//! AVX-512, sixteen 8-lane hardware gathers, the crate's one `unsafe` block, see
-//! [`gather`]; elsewhere a plain loop over the lanes, which the compiler turns into
-//! gathers where the target has them: `wide` has none; every index is clipped into the
-//! table, so they need no mask), the 27 exact `i64` subtractions in `i64x8`, the nine
+//! exact fractions, the sixteen table reads (eight adjacent pairs per lane: hardware
+//! gathers on x86-64 with AVX-512 or AVX2, the crate's only `unsafe` code, see `gather`;
+//! elsewhere a plain loop over the lanes; every index is clipped into the table, so they
+//! need no mask), the 27 exact `i64` subtractions in `i64x8`, the nine exact
 //! `i64 → f64` conversions, the `f64` combination in the scalar kernel's order (no fused
 //! multiply-add), the scaling by the quantum and the one rounding to `f32`. So every lane
 //! is **bit-identical** to the scalar kernel, NaN lanes included (NaN exactly where a
@@ -15,7 +14,7 @@
 use steradian_core::rsl::sat::{SatView, square_half_side};
 use wide::{f32x8, f64x8, i32x8, i64x8};
 
-use crate::lanes::{ColumnKernel, Lanes, drive, widen};
+use crate::lanes::{ColumnKernel, Lanes, drive, to_f64, widen};
 
 /// One axis of 8 boxes, lane-wise `steradian_core::rsl::sat::axis`: `(I0, a0, I1, a1)`, the
 /// indices as exact integers in `f32` lanes. A NaN lane gives NaN indices and fractions
@@ -72,7 +71,7 @@ pub fn box_sum(sat: &SatView<'_>, u0: f32x8, v0: f32x8, u1: f32x8, v1: f32x8) ->
                 .wrapping_sub(at(r1 + i0[k]))
                 .wrapping_sub(at(r0 + i1[k]).wrapping_sub(at(r0 + i0[k])))
         });
-        let r = (i64x8::new(s).round_float() * q).to_array();
+        let r = (to_f64(i64x8::new(s)) * q).to_array();
         f32x8::new(r.map(|v| v as f32))
     } else {
         fractional(sat, [i0, i1, j0, j1], [a0, a1, b0, b1])
@@ -130,26 +129,84 @@ fn entries(
 /// so that reading the pair is in bounds whatever the lanes hold (a valid view's table
 /// holds at least 2 × 2 entries; one too small for a pair reads nothing).
 ///
-/// On x86-64 with AVX-512 the sixteen reads are 8-lane hardware gathers
-/// ([`gather_avx512`]); elsewhere [`gather_lanes`], whose loop over the lanes LLVM turns
-/// into the target's gathers where it has them. It forms only 4-lane ones, even with
-/// AVX-512 (it prefers 256-bit vectors on current Intel cores), and the 8-lane gathers
-/// read the same entries with half the instructions.
+/// On x86-64 the reads are hardware gathers: sixteen 8-lane ones with AVX-512
+/// (`gather_avx512`), thirty-two 4-lane ones with AVX2 (`gather_avx2`); elsewhere
+/// `gather_lanes`. LLVM does not make the best of that loop on x86-64: with AVX-512 it
+/// forms only 4-lane gathers (it prefers 256-bit vectors on current Intel cores), and
+/// for AVX2 alone (`x86-64-v3`) none at all: it loads every entry on its own and stages
+/// it through memory.
 #[inline(always)]
 fn gather(sums: &[i64], rows: &[i64x8; 4], cols: &[i64x8; 2]) -> [i64x8; 16] {
     #[cfg(all(target_arch = "x86_64", target_feature = "avx512f"))]
     {
         gather_avx512(sums, rows, cols)
     }
-    #[cfg(not(all(target_arch = "x86_64", target_feature = "avx512f")))]
+    #[cfg(all(
+        target_arch = "x86_64",
+        target_feature = "avx2",
+        not(target_feature = "avx512f")
+    ))]
+    {
+        gather_avx2(sums, rows, cols)
+    }
+    #[cfg(not(all(
+        target_arch = "x86_64",
+        any(target_feature = "avx512f", target_feature = "avx2")
+    )))]
     {
         gather_lanes(sums, rows, cols)
     }
 }
 
+/// [`gather`] with AVX2's 4-lane `vpgatherqq`, four per row and column (the entry and the
+/// one after it, for each half of the lanes), where the build has AVX2 but not AVX-512.
+#[cfg(all(
+    target_arch = "x86_64",
+    target_feature = "avx2",
+    not(target_feature = "avx512f")
+))]
+#[allow(unsafe_code)]
+#[inline(always)]
+fn gather_avx2(sums: &[i64], rows: &[i64x8; 4], cols: &[i64x8; 2]) -> [i64x8; 16] {
+    use core::arch::x86_64::{__m256i, _mm256_i64gather_epi64};
+    use wide::{i64x4, u64x8};
+    let mut st = [i64x8::ZERO; 16];
+    let Some(last) = sums.len().checked_sub(2) else {
+        return st;
+    };
+    let last = u64x8::splat(last as u64);
+    let base = sums.as_ptr();
+    for (r, rk) in rows.iter().enumerate() {
+        for (c, ck) in cols.iter().enumerate() {
+            // Clipped as unsigned, as in `gather_avx512`.
+            let at = bytemuck::cast::<i64x8, u64x8>(*rk + *ck).min(last);
+            let pair = |h: i64x4| -> [i64x4; 2] {
+                let h = __m256i::from(h);
+                // SAFETY: as in `gather_avx512`: every lane of `h` is in
+                // `0 ..= sums.len() − 2` (clipped above), so the gathers read `sums[h]` and
+                // `sums[h + 1]` inside the slice; the target has AVX2 (`cfg` above).
+                unsafe {
+                    [
+                        i64x4::from(_mm256_i64gather_epi64::<8>(base, h)),
+                        i64x4::from(_mm256_i64gather_epi64::<8>(base.add(1), h)),
+                    ]
+                }
+            };
+            let [lo, hi] = bytemuck::cast::<u64x8, [i64x4; 2]>(at);
+            let ([e0, n0], [e1, n1]) = (pair(lo), pair(hi));
+            st[4 * r + 2 * c] = bytemuck::cast([e0, e1]);
+            st[4 * r + 2 * c + 1] = bytemuck::cast([n0, n1]);
+        }
+    }
+    st
+}
+
 /// [`gather`] as a plain loop over the lanes.
 #[cfg_attr(
-    all(target_arch = "x86_64", target_feature = "avx512f"),
+    all(
+        target_arch = "x86_64",
+        any(target_feature = "avx512f", target_feature = "avx2")
+    ),
     allow(dead_code)
 )]
 #[inline(always)]
@@ -227,7 +284,7 @@ fn combine(sat: &SatView<'_>, st: &[i64x8; 16], [a0, a1, b0, b1]: [f32x8; 4]) ->
     let t = [
         t0[0], t0[1], t0[2], t1[0], t1[1], t1[2], t2[0], t2[1], t2[2],
     ];
-    let f = |n: usize| t[n].round_float();
+    let f = |n: usize| to_f64(t[n]);
     let (a0, a1, b0, b1) = (widen(a0), widen(a1), widen(b0), widen(b1));
     let x = |n: usize| (f(n) + a1 * f(n + 1)) - a0 * f(n + 2);
     let (x_box, x_top, x_bottom) = (x(0), x(3), x(6));
@@ -316,13 +373,16 @@ mod tests {
     use super::*;
     use crate::lanes::tests::same;
 
-    /// The AVX-512 gathers read what the plain lane loop reads, for indices in the table,
-    /// at its last pair, beyond its end, wrapping and negative (both clip them as unsigned
-    /// integers: to the last pair),
-    /// and on a table too small to hold a pair (both read nothing).
-    #[cfg(all(target_arch = "x86_64", target_feature = "avx512f"))]
+    /// The x86 gathers (AVX-512 or AVX2, whichever the build has) read what the plain
+    /// lane loop reads, for indices in the table, at its last pair, beyond its end,
+    /// wrapping and negative (all clip them as unsigned integers: to the last pair), and
+    /// on a table too small to hold a pair (all read nothing).
+    #[cfg(all(
+        target_arch = "x86_64",
+        any(target_feature = "avx512f", target_feature = "avx2")
+    ))]
     #[test]
-    fn avx512_gathers_read_what_the_lane_loop_reads() {
+    fn x86_gathers_read_what_the_lane_loop_reads() {
         let sums: Vec<i64> = (0..40i64).map(|k| k * k * 7919 - 3 * k).collect();
         let last = sums.len() as i64 - 2;
         let picks = [0, 1, 5, last - 1, last, last + 1, i64::MAX, -1, i64::MIN];
@@ -336,7 +396,7 @@ mod tests {
                 core::array::from_fn(|c| i64x8::new(core::array::from_fn(|k| (k + c) as i64)));
             for table in [&sums[..], &sums[..2], &sums[..1], &[][..]] {
                 let (a, b) = (
-                    gather_avx512(table, &rows, &cols),
+                    gather(table, &rows, &cols),
                     gather_lanes(table, &rows, &cols),
                 );
                 for (x, y) in a.iter().zip(&b) {

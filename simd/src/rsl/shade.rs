@@ -35,7 +35,7 @@ use steradian_core::rsl::vdt::{R_MAX, R_MIN, VdtView};
 use steradian_core::rsl::vis_moments::{AxisKnots, VisMomentsView, axis_knots};
 use wide::{f32x8, f64x8, i64x8};
 
-use crate::lanes::widen;
+use crate::lanes::{to_f64, widen};
 
 /// Relative difference allowed between [`shade_batch`] and the scalar kernel, per channel,
 /// relative to the point's largest channel (see the module docs).
@@ -196,7 +196,7 @@ fn combine_lanes(rows: [[i64x8; 4]; 4], [a0, a1, b0, b1]: [f64x8; 4], q: [f64; 8
         let p = (m[2] - m[0]) - (l[2] - l[0]);
         let e1 = (m[3] - m[2]) - (l[3] - l[2]);
         let e0 = (m[1] - m[0]) - (l[1] - l[0]);
-        (p.round_float() + a1 * e1.round_float()) - a0 * e0.round_float()
+        (to_f64(p) + a1 * to_f64(e1)) - a0 * to_f64(e0)
     };
     let (xb, xt, xd) = (x(r0, r1), x(r1, r1p), x(r0, r0p));
     ((xb + b1 * xt) - b0 * xd) * f64x8::new(q)
@@ -637,7 +637,7 @@ fn vis_moments_lanes(
     // (`SatView::integer_box`'s operations), scaled by the quantum.
     let boxq = |s11: [i64; 8], s01: [i64; 8], s10: [i64; 8], s00: [i64; 8], q: [f64; 8]| {
         let [s11, s01, s10, s00] = [s11, s01, s10, s00].map(i64x8::new);
-        ((s11 - s01) - (s10 - s00)).round_float() * f64x8::new(q)
+        to_f64((s11 - s01) - (s10 - s00)) * f64x8::new(q)
     };
     let bv: [[f64x8; 3]; 3] = core::array::from_fn(|i| {
         core::array::from_fn(|j| boxq(sv[i + 1][j + 1], sv[i][j + 1], sv[i + 1][j], sv[i][j], q[0]))
