@@ -242,13 +242,12 @@ fn gather_avx512(sums: &[i64], rows: &[i64x8; 4], cols: &[i64x8; 2]) -> [i64x8; 
         return st;
     };
     let last = u64x8::splat(last as u64);
+    let base = sums.as_ptr();
     for (r, rk) in rows.iter().enumerate() {
         for (c, ck) in cols.iter().enumerate() {
             // Clipped as unsigned: a negative lane reads as 2⁶³ or more, so it too
             // becomes `last`.
-            let at = u64x8::from(__m512i::from(*rk + *ck)).min(last);
-            let at = __m512i::from(at);
-            let base = sums.as_ptr();
+            let at = __m512i::from(bytemuck::cast::<i64x8, u64x8>(*rk + *ck).min(last));
             // SAFETY: every lane of `at` is in `0 ..= sums.len() − 2` (clipped just above),
             // so both gathers read `sums[at]` and `sums[at + 1]` inside the slice; `base`
             // and `base.add(1)` point into it (`sums.len() ≥ 2`); `i64` has no invalid
