@@ -433,6 +433,21 @@ mod tests {
         assert!(a <= c && c <= k && a > 0, "{a} {c} {k}");
     }
 
+    /// A light of half-angle `α = 0.1` about `+z`, and a hemisphere about `(1, 0, −k·tan α)`
+    /// whose rim crosses the light's square along the line `p = k·tan α` (on the tangent
+    /// plane `z = 1` it covers `x ≥ k·tan α`).
+    fn rim_across_the_square(k: f32) -> (SphericalCap, SphericalCap) {
+        let alpha = 0.1f32;
+        let light = SphericalCap::new(Vec3::Z, alpha).unwrap();
+        let x0 = k * math::sinf(alpha) / math::cosf(alpha);
+        let occ = SphericalCap::new(
+            Vec3::new(1.0, 0.0, -x0).normalize(),
+            core::f32::consts::FRAC_PI_2,
+        )
+        .unwrap();
+        (light, occ)
+    }
+
     /// A hemisphere whose rim crosses the square along the line `p = 0.3·tan α` (about
     /// `+z` the square's axes are `x` and `y`; the light's cap is the disc of radius
     /// `tan α`), at depth 1: the two right cells are partial leaves. Of each one's 4 × 4
@@ -441,14 +456,7 @@ mod tests {
     /// midpoint rule keeps them whole and the left cells are dropped.
     #[test]
     fn fraction_leaves_count_the_covered_share() {
-        let alpha = 0.1f32;
-        let light = SphericalCap::new(Vec3::Z, alpha).unwrap();
-        let x0 = 0.3 * math::sinf(alpha) / math::cosf(alpha);
-        let occ = SphericalCap::new(
-            Vec3::new(1.0, 0.0, -x0).normalize(),
-            core::f32::consts::FRAC_PI_2,
-        )
-        .unwrap();
+        let (light, occ) = rim_across_the_square(0.3);
         let leaves = |l| {
             let mut got = [(0u32, 0.0f32); 8];
             let n = shadow_leaves(&light, &[occ], 1, l, |_, d, f| {
@@ -476,14 +484,7 @@ mod tests {
     /// 15 lit directions, and the cells right of them are covered whole (`f = 1`).
     #[test]
     fn fraction_leaves_are_exact_where_the_rim_follows_the_grid() {
-        let alpha = 0.1f32;
-        let light = SphericalCap::new(Vec3::Z, alpha).unwrap();
-        let x0 = 0.25 * math::sinf(alpha) / math::cosf(alpha);
-        let occ = SphericalCap::new(
-            Vec3::new(1.0, 0.0, -x0).normalize(),
-            core::f32::consts::FRAC_PI_2,
-        )
-        .unwrap();
+        let (light, occ) = rim_across_the_square(0.25);
         let (mut half, mut sevenths, mut whole, mut other) = (0, 0, 0, 0);
         shadow_leaves(&light, &[occ], 2, Leaves::Fraction, |_, d, f| {
             assert_eq!(d, 2);
