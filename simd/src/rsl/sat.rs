@@ -118,6 +118,7 @@ fn entries(
         row(index(next(j0, b0))),
         row(index(next(j1, b1))),
     ];
+    // Times 1 only to widen to `i64` lanes (`wide` has no other `i32x8 → i64x8`).
     let col = |i: f32x8| index(i).min(wl).widening_mul(i32x8::ONE);
     (rows, [col(i0), col(i1)])
 }
